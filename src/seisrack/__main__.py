@@ -1,0 +1,3 @@
+from seisrack.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""seisrack.dynamics"""
