@@ -1,1 +1,7 @@
-"""seisrack.dynamics"""
+"""Exact stick–slip dynamics of linear structures carrying sliding masses."""
+
+from seisrack.dynamics.engine import modal_basis, simulate
+from seisrack.dynamics.results import Event, TimeHistory
+from seisrack.dynamics.sliders import Sliders
+
+__all__ = ["Event", "Sliders", "TimeHistory", "modal_basis", "simulate"]

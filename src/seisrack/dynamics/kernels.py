@@ -1,0 +1,37 @@
+"""Backends of the stick–slip kernel: the same source compiled by numba or run by CPython.
+
+``_kernel.py`` is the pure-Python twin; ``_kernel_numba.py`` executes the very same source with
+``_JIT = numba.njit``, so the two cannot drift apart (pystrata keeps such a twin to run the same
+validation under both). numba is optional; without it the Python backend is used.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import logging
+from types import ModuleType
+
+from seisrack.errors import InputError
+
+_LOG = logging.getLogger(__name__)
+
+
+def numba_available() -> bool:
+    return importlib.util.find_spec("numba") is not None
+
+
+def get_kernel(backend: str = "auto") -> ModuleType:
+    """Return the kernel module for ``backend`` in {"auto", "numba", "python"}."""
+    if backend == "auto":
+        backend = "numba" if numba_available() else "python"
+    if backend == "python":
+        return importlib.import_module("seisrack.dynamics._kernel")
+    if backend == "numba":
+        if not numba_available():
+            raise InputError(
+                "backend", backend, '"python" (numba is not installed)',
+                hint="Install the 'fast' extra: pip install 'seisrack[fast]'",
+            )
+        return importlib.import_module("seisrack.dynamics._kernel_numba")
+    raise InputError("backend", backend, '"auto", "numba" or "python"')

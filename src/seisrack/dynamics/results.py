@@ -1,0 +1,106 @@
+"""Result of a stick–slip time history (never written back onto specs or models)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+EVENT_KINDS = ("slip", "stick", "reverse")
+
+
+@dataclass(frozen=True)
+class Event:
+    """A contact transition: ``kind`` in {"slip", "stick", "reverse"} of slider ``slider``."""
+
+    time_s: float
+    slider: int
+    kind: str
+
+
+@dataclass(frozen=True)
+class TimeHistory:
+    """Time history of a structure carrying sliders; all motion relative to the ground.
+
+    t: (n_t,) [s]; u, v, a: (n_t, n_dof) [m, m/s, m/s²] structural DOFs, computed on first
+    access from the modal coordinates ``q, qd, qdd`` and the mass-normalised basis ``phi``
+    (``u = q @ phi.T``); use :meth:`dof_response` for a few DOFs only;
+    slider_u, slider_v: (n_t, m) slider displacement / velocity [m, m/s];
+    sliding: (n_t, m) [m] slider displacement relative to its support node;
+    friction: (n_t, m) [N] horizontal force of the structure on each slider;
+    normal: (n_t, m) [N] normal force; stuck: (n_t, m) bool;
+    energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    phi: np.ndarray
+    slider_u: np.ndarray
+    slider_v: np.ndarray
+    sliding: np.ndarray
+    friction: np.ndarray
+    normal: np.ndarray
+    stuck: np.ndarray
+    slider_dof: np.ndarray
+    events: list[Event]
+    energy: dict[str, np.ndarray] = field(default_factory=dict)
+    status: str = "ok"
+    backend: str = "python"
+    n_substeps: int = 0
+
+    @cached_property
+    def u(self) -> np.ndarray:
+        return self.q @ self.phi.T
+
+    @cached_property
+    def v(self) -> np.ndarray:
+        return self.qd @ self.phi.T
+
+    @cached_property
+    def a(self) -> np.ndarray:
+        return self.qdd @ self.phi.T
+
+    def dof_response(self, dofs, kind: str = "u") -> np.ndarray:  # noqa: ANN001
+        """(n_t, len(dofs)) displacement ("u"), velocity ("v") or acceleration ("a")."""
+        src = {"u": self.q, "v": self.qd, "a": self.qdd}[kind]
+        return src @ self.phi[np.atleast_1d(dofs), :].T
+
+    @property
+    def sliding_velocity(self) -> np.ndarray:
+        """(n_t, m) [m/s] slider velocity relative to its support node."""
+        support = np.zeros_like(self.slider_v)
+        on = self.slider_dof >= 0
+        support[:, on] = self.dof_response(self.slider_dof[on], "v")
+        return self.slider_v - support
+
+    def sliding_phases(self, slider: int | None = None) -> int:
+        """Count sliding phases (a reversal starts a new phase), for one or all sliders."""
+        return sum(
+            1
+            for e in self.events
+            if e.kind in ("slip", "reverse") and (slider is None or e.slider == slider)
+        )
+
+    def energy_error(self) -> float:
+        """Relative residual of input = kinetic + strain + damping + friction (from t = 0)."""
+        if not self.energy:
+            return float("nan")
+        e = self.energy
+        lhs = e["input"]
+        rhs = (
+            (e["kinetic"] - e["kinetic"][0])
+            + (e["strain"] - e["strain"][0])
+            + e["damping"]
+            + e["friction"]
+        )
+        scale = max(
+            float(np.max(np.abs(e["input"]))),
+            float(np.max(e["kinetic"])),
+            float(np.max(e["strain"])),
+            float(np.max(np.abs(e["damping"]))) + float(np.max(np.abs(e["friction"]))),
+            1e-300,
+        )
+        return float(np.max(np.abs(lhs - rhs)) / scale)
