@@ -1,1 +1,21 @@
-"""seisrack.model"""
+"""Rack specification (TOML → frozen dataclasses) and its compilation to a FrameModel."""
+
+from seisrack.model.compile import compile_rack, sliding_limits
+from seisrack.model.frame_model import BEAM, UPRIGHT, FrameModel
+from seisrack.model.load import load_rack, rack_from_dict
+from seisrack.model.spec import (
+    Connections,
+    Damping,
+    Geometry,
+    Material,
+    Pallet,
+    RackSpec,
+    Section,
+    with_friction,
+)
+
+__all__ = [
+    "BEAM", "UPRIGHT", "Connections", "Damping", "FrameModel", "Geometry", "Material", "Pallet",
+    "RackSpec", "Section", "compile_rack", "load_rack", "rack_from_dict", "sliding_limits",
+    "with_friction",
+]

@@ -1,0 +1,146 @@
+"""Compile a :class:`RackSpec` into a :class:`FrameModel` (arrays only).
+
+Steps: mesh (:mod:`seisrack.model.rack_mesh`) → vectorised assembly of K and consistent M
+(:mod:`seisrack.fe.assembly`) → pallets (vertical mass on their node's uy DOF; horizontal mass
+kept apart as sliders) → damping (:mod:`seisrack.fe.damping`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+
+import numpy as np
+import scipy.linalg
+
+from seisrack.errors import InputError
+from seisrack.fe import damping as fe_damping
+from seisrack.fe.assembly import assemble
+from seisrack.fe.mesh import FloatArray
+from seisrack.fe.modal import modal_from_matrices
+from seisrack.model.frame_model import FrameModel
+from seisrack.model.rack_mesh import RackMesh, build_rack_mesh
+from seisrack.model.spec import Connections, Pallet, RackSpec
+
+log = logging.getLogger(__name__)
+
+
+def compile_rack(spec: RackSpec) -> FrameModel:
+    """Build the frame model of ``spec``; raises InputError if the frame is a mechanism."""
+    rm = build_rack_mesh(spec)
+    mesh = rm.mesh
+    K, M = assemble(mesh)
+    _check_stable(K, spec)
+
+    n_p = len(spec.pallets)
+    p_node = np.array([_pallet_node(rm, p) for p in spec.pallets], dtype=np.int64)
+    p_dof = mesh.node_dofs[p_node, 0] if n_p else np.zeros(0, dtype=np.int64)
+    p_vdof = mesh.node_dofs[p_node, 1] if n_p else np.zeros(0, dtype=np.int64)
+    p_mass = np.array([p.mass for p in spec.pallets], dtype=float)
+    np.add.at(M, (p_vdof, p_vdof), p_mass)  # vertical pallet mass moves with its node
+    lim_neg, lim_pos = sliding_limits(spec)
+
+    r_x = _influence(mesh.node_dofs[:, 0], mesh.n_dof)
+    r_y = _influence(mesh.node_dofs[:, 1], mesh.n_dof)
+    Mt = M.copy()
+    np.add.at(Mt, (p_dof, p_dof), p_mass)
+    a0, a1 = _damping(spec, K, Mt, r_x, r_y)
+
+    level_dofs = []
+    for lev in range(spec.geometry.n_levels):
+        nodes = [rm.level_nodes[:, lev]] + [rm.beam_nodes[(lev, b)]
+                                            for b in range(spec.geometry.n_bays)]
+        level_dofs.append(np.unique(mesh.node_dofs[np.concatenate(nodes), 0]))
+
+    member_mass = float(np.sum(mesh.density * mesh.A * mesh.lengths))
+    log.info("compiled rack: %d nodes, %d elements, %d DOFs, %d pallets",
+             mesh.nodes.shape[0], mesh.n_el, mesh.n_dof, n_p)
+    return _read_only(FrameModel(
+        mesh=mesh, K=K, M=M, C=a0 * M + a1 * K, damping_coefficients=(a0, a1),
+        r_x=r_x, r_y=r_y, pallet_dof=p_dof, pallet_vdof=p_vdof, pallet_node=p_node,
+        pallet_mass=p_mass,
+        pallet_mu_static=np.array([p.mu_static for p in spec.pallets], dtype=float),
+        pallet_mu_dynamic=np.array([p.mu_dynamic for p in spec.pallets], dtype=float),
+        pallet_limit_neg=lim_neg, pallet_limit_pos=lim_pos, level_dofs=tuple(level_dofs),
+        level_y=np.array(spec.geometry.level_y), upright_x=np.array(spec.geometry.upright_x),
+        element_kind=rm.element_kind, element_storey=rm.element_storey,
+        element_line=rm.element_line, base_nodes=rm.base_nodes, level_nodes=rm.level_nodes,
+        upright_base_elements=rm.upright_base_elements,
+        upright_below_elements=rm.upright_below_elements,
+        upright_above_elements=rm.upright_above_elements,
+        member_mass=member_mass, g=spec.g, title=spec.title,
+    ))
+
+
+def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:
+    """Allowed sliding of each pallet towards -x and +x [m], both >= 0.
+
+    An explicit ``sliding_limit`` applies to both sides. Otherwise each side is the free distance
+    from the pallet's edge to the nearest obstacle on that side: the edge of the neighbouring
+    pallet on the same beam, or the upright (taken at its centreline, i.e. the bay end).
+    """
+    n = len(spec.pallets)
+    neg, pos = np.zeros(n), np.zeros(n)
+    for i, p in enumerate(spec.pallets):
+        left, right = p.position - p.width / 2, p.position + p.width / 2
+        wall_l, wall_r = 0.0, spec.geometry.bays[p.bay - 1]
+        for q in spec.pallets:
+            if q is p or (q.bay, q.level) != (p.bay, p.level):
+                continue
+            if q.position < p.position:
+                wall_l = max(wall_l, q.position + q.width / 2)
+            elif q.position > p.position:
+                wall_r = min(wall_r, q.position - q.width / 2)
+        neg[i], pos[i] = max(left - wall_l, 0.0), max(wall_r - right, 0.0)
+        if p.sliding_limit is not None:
+            neg[i] = pos[i] = p.sliding_limit
+    return neg, pos
+
+
+def _read_only(model: FrameModel) -> FrameModel:
+    """Lock every array of the compiled model (it is shared, never mutated)."""
+    for obj in (model, model.mesh):
+        for f in dataclasses.fields(obj):
+            value = getattr(obj, f.name)
+            for arr in value if isinstance(value, tuple) else (value,):
+                if isinstance(arr, np.ndarray):
+                    arr.flags.writeable = False
+    return model
+
+
+def _pallet_node(rm: RackMesh, p: Pallet) -> int:
+    st = rm.beam_stations[(p.level - 1, p.bay - 1)]
+    return int(rm.beam_nodes[(p.level - 1, p.bay - 1)][np.abs(st - p.position).argmin()])
+
+
+def _influence(dofs: np.ndarray, n_dof: int) -> FloatArray:
+    r = np.zeros(n_dof)
+    r[dofs[dofs >= 0]] = 1.0
+    return r
+
+
+def _check_stable(K: FloatArray, spec: RackSpec) -> None:
+    try:
+        scipy.linalg.cho_factor(K)
+    except np.linalg.LinAlgError:
+        c = spec.connections
+        raise InputError(
+            "connections", {"beam_to_upright": Connections.describe_value(c.beam_to_upright),
+                            "base": Connections.describe_value(c.base)},
+            "connections that make the frame stable (pinned bases need beam-to-upright "
+            "joints with a stiffness > 0)", source=spec.source,
+            hint="The stiffness matrix is singular: the frame is a sway mechanism") from None
+
+
+def _damping(spec: RackSpec, K: FloatArray, Mt: FloatArray, r_x: FloatArray, r_y: FloatArray
+             ) -> tuple[float, float]:
+    d = spec.damping
+    if d.kind == "stiffness":
+        if d.period == "first":
+            period = float(modal_from_matrices(K, Mt, r_x, r_y, n_modes=1).periods[0])
+        else:
+            period = float(d.period)
+        return fe_damping.stiffness_proportional(d.ratio, period)
+    if d.kind == "rayleigh":
+        return fe_damping.rayleigh(d.pairs)
+    return 0.0, 0.0

@@ -1,0 +1,246 @@
+"""Load a rack from TOML and validate it (the schema is in ``docs/dev/interfaces.md``).
+
+Everything a user can get wrong is caught here and reported as an
+:class:`~seisrack.errors.InputError` naming the field path (``pallets[2].mu_dynamic``), the value
+and what is allowed; malformed TOML becomes a :class:`~seisrack.errors.FileFormatError` with the
+line number.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from seisrack.errors import FileFormatError, InputError
+from seisrack.model._reader import Table, check_number
+from seisrack.model.spec import (
+    DEFAULT_G,
+    DEFAULT_PALLET_WIDTH,
+    DEFAULT_SUBDIVISIONS,
+    PINNED,
+    RIGID,
+    Connections,
+    Damping,
+    Geometry,
+    Material,
+    Pallet,
+    RackSpec,
+    Section,
+)
+
+_TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping", "pallets")
+_LINE_RE = re.compile(r"\(at line (\d+), column (\d+)\)")
+_GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
+
+
+def load_rack(path: str | Path) -> RackSpec:
+    """Read and validate a rack TOML file."""
+    p = Path(path)
+    with p.open("rb") as fh:
+        raw = fh.read()
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
+    except tomllib.TOMLDecodeError as exc:
+        msg = str(exc)
+        m = _LINE_RE.search(msg)
+        line = int(m.group(1)) if m else None
+        msg = _LINE_RE.sub("", msg).strip()
+        if m:
+            msg += f" (column {m.group(2)})"
+        raise FileFormatError(str(p), f"malformed TOML: {msg}", line=line) from None
+    return rack_from_dict(data, source=str(p))
+
+
+def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
+    """Validate a parsed TOML document (a dict) and build a :class:`RackSpec`."""
+    root = Table(d, "", source)
+    title = root.string("title", "")
+    g = root.number("g", DEFAULT_G, positive=True, unit="m/s²")
+    material = _material(root.table("material"))
+    sections = _sections(root.table("sections"))
+    geometry = _geometry(root.table("geometry"), sections)
+    connections = _connections(root.table("connections"))
+    damping = _damping(root.table("damping", {}))
+    raw_pallets = root.array("pallets", [])
+    pallets = tuple(
+        _pallet(Table(p, f"pallets[{i}]", source), geometry) for i, p in enumerate(raw_pallets)
+    )
+    root.finish(_TOP_KEYS)
+    _check_overlaps(pallets, source)
+    return RackSpec(material=material, sections=sections, geometry=geometry,
+                    connections=connections, damping=damping, pallets=pallets, g=g,
+                    title=title, source=source)
+
+
+def check_friction(f_static: str, mu_s: Any, f_dynamic: str, mu_d: Any,
+                   source: str | None = None) -> tuple[float, float]:
+    """Validate a (static, dynamic) friction pair: both >= 0 and dynamic <= static."""
+    s = check_number(mu_s, f_static, nonnegative=True, source=source)
+    k = check_number(mu_d, f_dynamic, nonnegative=True, source=source)
+    if k > s:
+        raise InputError(f_dynamic, mu_d, f"a value <= {f_static} ({s:g})", source=source,
+                         hint="The dynamic friction coefficient cannot exceed the static one")
+    return s, k
+
+
+def _material(t: Table) -> Material:
+    m = Material(E=t.number("E", positive=True, unit="Pa"),
+                 density=t.number("density", positive=True, unit="kg/m³"))
+    t.finish(("E", "density"))
+    return m
+
+
+def _sections(t: Table) -> dict[str, Section]:
+    out: dict[str, Section] = {}
+    for name in list(t.data):
+        s = t.table(name)
+        out[name] = Section(name=name, A=s.number("A", positive=True, unit="m²"),
+                            I=s.number("I", positive=True, unit="m⁴"))
+        s.finish(("A", "I"))
+    if not out:
+        raise t.error("<name>", {}, "at least one named section, e.g. [sections.beam]")
+    return out
+
+
+def _section_names(t: Table, key: str, n: int, what: str, sections: dict[str, Section]
+                   ) -> tuple[str, ...]:
+    value = t.raw(key)
+    allowed = f"a section name ({', '.join(sorted(sections))}) or an array of {n} names"
+    names = [value] * n if isinstance(value, str) else value
+    if not isinstance(names, list) or len(names) != n:
+        raise t.error(key, value, allowed + f", one per {what}")
+    for i, name in enumerate(names):
+        if not isinstance(name, str) or name not in sections:
+            field = key if isinstance(value, str) else f"{key}[{i}]"
+            raise t.error(field, name, f"one of the [sections]: {', '.join(sorted(sections))}")
+    return tuple(names)
+
+
+def _lengths(t: Table, key: str) -> tuple[float, ...]:
+    values = t.array(key, min_len=1)
+    return tuple(check_number(v, f"{t.field(key)}[{i}]", positive=True, unit="m",
+                              source=t.source) for i, v in enumerate(values))
+
+
+def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
+    bays = _lengths(t, "bays")
+    levels = _lengths(t, "levels")
+    geom = Geometry(
+        bays=bays, levels=levels,
+        beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
+        upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
+        subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
+    )
+    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions"))
+    return geom
+
+
+def _spring(t: Table, key: str) -> float:
+    value = t.raw(key)
+    allowed = 'a stiffness >= 0 [N·m/rad], "rigid" or "pinned"'
+    if isinstance(value, str):
+        word = value.strip().lower()
+        if word == "rigid":
+            return RIGID
+        if word == "pinned":
+            return PINNED
+        raise t.error(key, value, allowed)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value) \
+            or value < 0:
+        raise t.error(key, value, allowed)
+    return float(value)
+
+
+def _connections(t: Table) -> Connections:
+    c = Connections(beam_to_upright=_spring(t, "beam_to_upright"), base=_spring(t, "base"))
+    t.finish(("beam_to_upright", "base"))
+    return c
+
+
+def _period(t: Table, key: str, value: Any) -> float:
+    return check_number(value, t.field(key), positive=True, unit="s", source=t.source)
+
+
+def _ratio(t: Table, key: str, value: Any) -> float:
+    r = check_number(value, t.field(key), nonnegative=True, source=t.source)
+    if r >= 1.0:
+        raise t.error(key, value, "a damping ratio in [0, 1) (0.02 means 2 %)")
+    return r
+
+
+def _damping(t: Table) -> Damping:
+    kind = t.string("kind", "none")
+    if kind == "none":
+        t.finish(("kind",))
+        return Damping()
+    if kind == "stiffness":
+        ratio = _ratio(t, "ratio", t.raw("ratio"))
+        period_raw = t.raw("period", "first")
+        period: Any = "first" if period_raw == "first" else _period(t, "period", period_raw)
+        t.finish(("kind", "ratio", "period"))
+        return Damping(kind="stiffness", ratio=ratio, period=period)
+    if kind == "rayleigh":
+        pairs_raw = t.array("pairs")
+        pairs = []
+        for i, pair in enumerate(pairs_raw):
+            if not isinstance(pair, list) or len(pair) != 2:
+                raise t.error(f"pairs[{i}]", pair, "a [period_s, ratio] pair")
+            pairs.append((_period(t, f"pairs[{i}][0]", pair[0]),
+                          _ratio(t, f"pairs[{i}][1]", pair[1])))
+        if len(pairs) != 2:
+            raise t.error("pairs", pairs_raw, "exactly two [period_s, ratio] pairs")
+        if pairs[0][0] == pairs[1][0]:
+            raise t.error("pairs", pairs_raw, "two pairs with different periods")
+        t.finish(("kind", "pairs"))
+        return Damping(kind="rayleigh", pairs=tuple(pairs))
+    raise t.error("kind", kind, '"stiffness", "rayleigh" or "none"')
+
+
+def _pallet(t: Table, geom: Geometry) -> Pallet:
+    mass = t.number("mass", positive=True, unit="kg")
+    bay = t.integer("bay")
+    if not 1 <= bay <= geom.n_bays:
+        raise t.error("bay", bay, f"an integer from 1 to {geom.n_bays} (the rack has "
+                                  f"{geom.n_bays} bay(s))")
+    level = t.integer("level")
+    if not 1 <= level <= geom.n_levels:
+        raise t.error("level", level, f"an integer from 1 to {geom.n_levels} (the rack has "
+                                      f"{geom.n_levels} beam level(s))")
+    mu_s, mu_d = check_friction(t.field("mu_static"), t.raw("mu_static"),
+                                t.field("mu_dynamic"), t.raw("mu_dynamic"), source=t.source)
+    width = t.number("width", DEFAULT_PALLET_WIDTH, positive=True, unit="m")
+    span = geom.bays[bay - 1]
+    position = t.number("position", unit="m")
+    lo, hi = width / 2, span - width / 2
+    if not (lo - _GEOM_TOL <= position <= hi + _GEOM_TOL):
+        allowed = (f"a centre position in [{lo:g}, {hi:g}] m so that the pallet (width "
+                   f"{width:g} m) lies within bay {bay} (span {span:g} m)")
+        if hi < lo:
+            allowed = f"a pallet no wider than its bay: width {width:g} m > span {span:g} m"
+        raise t.error("position", position, allowed)
+    limit_raw = t.raw("sliding_limit", None)
+    limit = None if limit_raw is None else check_number(
+        limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
+    t.finish(("mass", "bay", "level", "position", "mu_static", "mu_dynamic", "width",
+              "sliding_limit"))
+    return Pallet(mass=mass, bay=bay, level=level, position=position, mu_static=mu_s,
+                  mu_dynamic=mu_d, width=width, sliding_limit=limit)
+
+
+def _check_overlaps(pallets: tuple[Pallet, ...], source: str | None) -> None:
+    for i, a in enumerate(pallets):
+        for j in range(i):
+            b = pallets[j]
+            if (a.bay, a.level) != (b.bay, b.level):
+                continue
+            gap = abs(a.position - b.position) - (a.width + b.width) / 2
+            if gap < -_GEOM_TOL:
+                raise InputError(
+                    f"pallets[{i}].position", a.position,
+                    f"a position that does not overlap pallets[{j}] (centre {b.position:g} m, "
+                    f"width {b.width:g} m) on bay {a.bay}, level {a.level}", source=source)

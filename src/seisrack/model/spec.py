@@ -1,0 +1,178 @@
+"""Rack specification: frozen dataclasses describing what the user wrote.
+
+Specs are validated once, at the boundary (:mod:`seisrack.model.load`); code that receives a
+:class:`RackSpec` may trust it. All quantities are SI (m, kg, Pa, N·m/rad).
+
+Connection stiffnesses are floats: ``math.inf`` stands for a rigid joint and ``0.0`` for a
+pinned one (the TOML words ``"rigid"`` and ``"pinned"`` map to these).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+#: Default pallet width along the beam [m] (EUR pallet, 1200 x 800 mm, long side across the beams).
+DEFAULT_PALLET_WIDTH = 0.8
+#: Default elements per member.
+DEFAULT_SUBDIVISIONS = 4
+#: Default gravity [m/s²].
+DEFAULT_G = 9.81
+
+RIGID = math.inf
+PINNED = 0.0
+
+DampingKind = Literal["stiffness", "rayleigh", "none"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """Linear elastic material. ``E`` [Pa], ``density`` [kg/m³]."""
+
+    E: float
+    density: float
+
+
+@dataclass(frozen=True)
+class Section:
+    """A named cross-section: area ``A`` [m²], second moment of area ``I`` [m⁴] (in-plane)."""
+
+    name: str
+    A: float
+    I: float
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Bays (spans, left to right) and levels (storey heights, bottom to top).
+
+    ``beam_sections[k]`` is the section name of the beams of level ``k`` (0-based) and
+    ``upright_sections[k]`` that of the uprights of storey ``k``.
+    """
+
+    bays: tuple[float, ...]
+    levels: tuple[float, ...]
+    beam_sections: tuple[str, ...]
+    upright_sections: tuple[str, ...]
+    subdivisions: int = DEFAULT_SUBDIVISIONS
+
+    @property
+    def n_bays(self) -> int:
+        return len(self.bays)
+
+    @property
+    def n_levels(self) -> int:
+        return len(self.levels)
+
+    @property
+    def upright_x(self) -> tuple[float, ...]:
+        """x of each upright [m], left to right (``n_bays + 1`` values)."""
+        xs = [0.0]
+        for span in self.bays:
+            xs.append(xs[-1] + span)
+        return tuple(xs)
+
+    @property
+    def level_y(self) -> tuple[float, ...]:
+        """Elevation of each beam level [m], bottom to top."""
+        ys: list[float] = []
+        y = 0.0
+        for h in self.levels:
+            y += h
+            ys.append(y)
+        return tuple(ys)
+
+
+@dataclass(frozen=True)
+class Connections:
+    """Rotational spring stiffnesses [N·m/rad]; ``inf`` = rigid, ``0`` = pinned."""
+
+    beam_to_upright: float
+    base: float
+
+    @staticmethod
+    def describe_value(k: float) -> str:
+        if math.isinf(k):
+            return "rigid"
+        if k == 0.0:
+            return "pinned"
+        return f"{k:g} N·m/rad"
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Viscous damping of the frame.
+
+    - ``kind="stiffness"``: C = a1·K with ratio ``ratio`` at ``period`` [s] or, when ``period`` is
+      ``"first"``, at the first period of the frame with the pallets rigidly attached.
+    - ``kind="rayleigh"``: C = a0·M + a1·K through the two ``(period [s], ratio)`` ``pairs``.
+    - ``kind="none"``: C = 0.
+    """
+
+    kind: DampingKind = "none"
+    ratio: float = 0.0
+    period: float | Literal["first"] = "first"
+    pairs: tuple[tuple[float, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class Pallet:
+    """A pallet resting on the beams of one bay and level.
+
+    ``bay`` and ``level`` are 1-based (as in the TOML). ``position`` [m] is the pallet centre from
+    the left upright of its bay; ``width`` [m] its extent along the beam. ``sliding_limit`` [m] is
+    the allowed sliding on each side, or ``None`` for the free distance to the next obstacle.
+    """
+
+    mass: float
+    bay: int
+    level: int
+    position: float
+    mu_static: float
+    mu_dynamic: float
+    width: float = DEFAULT_PALLET_WIDTH
+    sliding_limit: float | None = None
+
+
+@dataclass(frozen=True)
+class RackSpec:
+    """A complete, validated rack description."""
+
+    material: Material
+    sections: Mapping[str, Section]
+    geometry: Geometry
+    connections: Connections
+    damping: Damping = field(default_factory=Damping)
+    pallets: tuple[Pallet, ...] = ()
+    g: float = DEFAULT_G
+    title: str = ""
+    source: str | None = None
+
+    def beam_section(self, level: int) -> Section:
+        """Section of the beams of 0-based ``level``."""
+        return self.sections[self.geometry.beam_sections[level]]
+
+    def upright_section(self, storey: int) -> Section:
+        """Section of the uprights of 0-based ``storey``."""
+        return self.sections[self.geometry.upright_sections[storey]]
+
+    @property
+    def pallet_mass_total(self) -> float:
+        return float(sum(p.mass for p in self.pallets))
+
+
+def with_friction(spec: RackSpec, mu_static: float, mu_dynamic: float | None = None) -> RackSpec:
+    """Return a copy of ``spec`` with every pallet's friction coefficients overridden.
+
+    ``mu_dynamic`` defaults to ``mu_static``. The values are validated like TOML input.
+    """
+    from seisrack.model.load import check_friction
+
+    mu_d = mu_static if mu_dynamic is None else mu_dynamic
+    check_friction("mu_static", mu_static, "mu_dynamic", mu_d)
+    pallets = tuple(
+        replace(p, mu_static=float(mu_static), mu_dynamic=float(mu_d)) for p in spec.pallets
+    )
+    return replace(spec, pallets=pallets)
