@@ -1,0 +1,1 @@
+"""seisrack.validation: the paper's validation examples (issue #3)."""
