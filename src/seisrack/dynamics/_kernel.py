@@ -115,15 +115,15 @@ def _trial(
     c0 = 4.0 / (h * h)
     c1 = 4.0 / h
     c2 = 2.0 / h
+    # incremental form: K_hat dq = p1 - K q0 + C qd0 + (4/h) qd0 + qdd0 (no cancellation for
+    # short sub-steps, where 4/h^2 would amplify the round-off of q0)
+    _damp_mul(cd, Cq, diag, qd0, rhs)
     for i in range(n):
-        tmp[i] = c2 * q0[i] + qd0[i]
-    _damp_mul(cd, Cq, diag, tmp, rhs)
-    for i in range(n):
-        rhs[i] += pext1[i] + c0 * q0[i] + c1 * qd0[i] + qdd0[i]
-    _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)
+        rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
+    _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)  # qhat holds the free increment
     # support velocity of the "free" (lam = 0) prediction
     for i in range(n):
-        tmp[i] = c2 * (qhat[i] - q0[i]) - qd0[i]
+        tmp[i] = c2 * qhat[i] - qd0[i]
     _mv(P, tmp, vnode)
     for j in range(m):
         b[j] = wd0[j] + 0.5 * h * (wdd0[j] - ag1) - vnode[j]
@@ -167,9 +167,10 @@ def _trial(
     # structure end state
     _mv(HPt, lam1, f)
     for i in range(n):
-        q1[i] = qhat[i] - f[i]
-        qd1[i] = c2 * (q1[i] - q0[i]) - qd0[i]
-        qdd1[i] = c0 * (q1[i] - q0[i]) - c1 * qd0[i] - qdd0[i]
+        dq = qhat[i] - f[i]
+        q1[i] = q0[i] + dq
+        qd1[i] = c2 * dq - qd0[i]
+        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
     _mv(P, qd1, vnode)
     vn = vnode
     for j in range(m):
@@ -191,6 +192,21 @@ def _event_values(stuck, sig, lam, N, s, mus, e):
             e[j] = abs(lam[j]) - mus[j] * N[j]
         else:
             e[j] = -sig[j] * s[j]
+
+
+@_JIT
+def _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag, pext, lam, qdd, wdd):
+    """Accelerations from equilibrium for given slider forces ``lam``."""
+    n = kd.shape[0]
+    m = mass.shape[0]
+    _damp_mul(cd, Cq, diag, qd, qdd)
+    for i in range(n):
+        acc = pext[i] - qdd[i] - kd[i] * q[i]
+        for j in range(m):
+            acc -= P[j, i] * lam[j]
+        qdd[i] = acc
+    for j in range(m):
+        wdd[j] = -ag + lam[j] / mass[j]
 
 
 @_JIT
@@ -273,11 +289,18 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
 @_JIT
 def run_kernel(
     kd, cd, Cq, diag, P, mass, mus, mud, dt, ag, pext, N, q_init, qd_init,
+    resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
     track_energy, max_events, max_substeps,
     out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy,
     ev_time, ev_slider, ev_kind,
 ):
     """Integrate ``n_steps = ag.shape[0] - 1`` steps. Returns (status, n_events, n_substeps).
+
+    Resumable: with ``resume`` the sliders start from ``w_state, wd_state, stuck_state,
+    sig_state`` and the cumulative energies from ``e_state`` (input, damping, friction);
+    otherwise they start stuck on their supports. On return these arrays hold the final state,
+    so a long run can be split into chunks (for progress reporting) without changing the result.
+    ``t_offset`` [s] is added to event times.
 
     ag: (n_t,) ground acceleration at grid points; pext: (n_t, n) modal external load
     (``Φ^T (F - M r a_g)``); N: (n_t, m) normal force of each slider.
@@ -296,28 +319,37 @@ def run_kernel(
     q = q_init.copy()
     qd = qd_init.copy()
     qdd = np.zeros(n)
-    w = P @ q
-    wd = P @ qd
     wdd = np.zeros(m)
     lam = np.zeros(m)
-    stuck = np.ones(m, dtype=np.bool_)
-    sig = np.ones(m)
-    cand = np.ones(m, dtype=np.bool_)
     forced = np.zeros(m, dtype=np.bool_)
+    if resume:
+        w = w_state.copy()
+        wd = wd_state.copy()
+        stuck = stuck_state.copy()
+        sig = sig_state.copy()
+        E_in = e_state[0]
+        E_damp = e_state[1]
+        E_fric = e_state[2]
+    else:
+        w = P @ q
+        wd = P @ qd
+        stuck = np.ones(m, dtype=np.bool_)
+        sig = np.ones(m)
+        E_in = 0.0
+        E_damp = 0.0
+        E_fric = 0.0
+    cand = stuck.copy()
     _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag[0], pext[0], N[0],
                 stuck, sig, cand, forced, qdd, wdd, lam)
     n_ev = 0
     status = STATUS_OK
     for j in range(m):
-        if not stuck[j]:
+        if cand[j] and not stuck[j]:
             if n_ev < max_events:
-                ev_time[n_ev] = 0.0
+                ev_time[n_ev] = t_offset
                 ev_slider[n_ev] = j
                 ev_kind[n_ev] = KIND_SLIP
             n_ev += 1
-    E_in = 0.0
-    E_damp = 0.0
-    E_fric = 0.0
     # buffers
     q1 = np.empty(n)
     qd1 = np.empty(n)
@@ -372,11 +404,11 @@ def run_kernel(
         se = 0.0
         for i in range(n):
             se += 0.5 * kd[i] * q[i] * q[i]
-        out_energy[0, 0] = 0.0
+        out_energy[0, 0] = E_in
         out_energy[0, 1] = ke
         out_energy[0, 2] = se
-        out_energy[0, 3] = 0.0
-        out_energy[0, 4] = 0.0
+        out_energy[0, 3] = E_damp
+        out_energy[0, 4] = E_fric
     for step in range(n_t - 1):
         tau = 0.0  # fraction of the step already integrated
         n_sub = 0
@@ -413,23 +445,25 @@ def run_kernel(
             for j in range(m):
                 s0[j] = wd[j] - vn0[j]
                 N_lo[j] = N[step, j] + tau * (N[step + 1, j] - N[step, j])
-                tolF[j] = 1e-11 * mus[j] * max(N_lo[j], N[step + 1, j]) + 1e-300
+                if stuck[j]:
+                    tolF[j] = 1e-11 * mus[j] * max(N_lo[j], N[step + 1, j]) + 1e-300
+                else:
+                    # a reversal/stick must be a real sign change of the relative velocity, not
+                    # round-off around zero just after a slip onset with mu_d = mu_s
+                    tolF[j] = 1e-9 * (abs(wd[j]) + abs(vn0[j]) + mud[j] * N_lo[j] / mass[j] * dt)
             _event_values(stuck, sig, lam, N_lo, s0, mus, e_lo)
             _event_values(stuck, sig, lam1, N[step + 1], s1, mus, e_hi)
             any_ev = False
             for j in range(m):
-                if stuck[j]:
-                    if e_hi[j] > tolF[j]:
-                        any_ev = True
-                elif e_hi[j] > 0.0:
+                if e_hi[j] > tolF[j]:
                     any_ev = True
             theta_hi = 1.0  # fractions of the remaining sub-step
             if any_ev:
-                # Illinois regula falsi on the earliest violated event function
+                # regula falsi on the earliest violated event function, with a bisection
+                # step whenever the same end of the bracket is kept twice in a row. ``e_lo`` and
+                # ``e_hi`` always hold the true event values at the bracket ends.
                 theta_lo = 0.0
-                for j in range(m):
-                    if e_lo[j] > 0.0:
-                        e_lo[j] = 0.0
+                streak = 0
                 side = 0
                 # the hi state is the current trial
                 qb[:] = q1
@@ -440,15 +474,15 @@ def run_kernel(
                 wddb[:] = wdd1
                 lamb[:] = lam1
                 sb[:] = s1
-                for _it in range(80):
+                for _it in range(100):
                     # earliest crossing by linear interpolation
                     th = theta_hi
                     jmin = -1
                     for j in range(m):
-                        viol = e_hi[j] > (tolF[j] if stuck[j] else 0.0)
-                        if viol:
-                            den = e_hi[j] - e_lo[j]
-                            frac = -e_lo[j] / den if den > 0.0 else 0.0
+                        if e_hi[j] > tolF[j]:
+                            elo = min(e_lo[j], 0.0)
+                            den = e_hi[j] - elo
+                            frac = -elo / den if den > 0.0 else 0.0
                             tj = theta_lo + frac * (theta_hi - theta_lo)
                             if tj < th or jmin < 0:
                                 th = tj
@@ -457,14 +491,16 @@ def run_kernel(
                         break
                     # convergence: the violated function is tiny at hi
                     if stuck[jmin]:
-                        conv = e_hi[jmin] <= 1e-9 * mus[jmin] * N[step + 1, jmin] + tolF[jmin]
+                        conv = e_hi[jmin] <= 1e-10 * mus[jmin] * N[step + 1, jmin] + tolF[jmin]
                     else:
-                        vs = abs(wdb[jmin]) + abs(wdb[jmin] - sb[jmin]) + 1e-30
-                        conv = e_hi[jmin] <= 1e-13 * vs
-                    if conv or theta_hi - theta_lo <= 1e-15:
-                        break
-                    # keep strictly inside the bracket
+                        conv = e_hi[jmin] <= 2.0 * tolF[jmin]
                     span = theta_hi - theta_lo
+                    if conv or span * hrem <= 1e-12 * dt:
+                        break
+                    if streak >= 2:
+                        th = theta_lo + 0.5 * span
+                        streak = 0
+                    # keep strictly inside the bracket
                     if th <= theta_lo + 1e-6 * span:
                         th = theta_lo + 1e-6 * span
                     if th >= theta_hi - 1e-6 * span:
@@ -486,7 +522,7 @@ def run_kernel(
                     _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
                     viol_try = False
                     for j in range(m):
-                        if e_try[j] > (tolF[j] if stuck[j] else 0.0):
+                        if e_try[j] > tolF[j]:
                             viol_try = True
                     if viol_try:
                         theta_hi = th
@@ -499,16 +535,12 @@ def run_kernel(
                         wddb[:] = wdd1
                         lamb[:] = lam1
                         sb[:] = s1
-                        if side == 1:
-                            for j in range(m):
-                                e_lo[j] *= 0.5
+                        streak = streak + 1 if side == 1 else 1
                         side = 1
                     else:
                         theta_lo = th
                         e_lo[:] = e_try
-                        if side == -1:
-                            for j in range(m):
-                                e_hi[j] *= 0.5
+                        streak = streak + 1 if side == -1 else 1
                         side = -1
                 # accept the (tiny-violation) hi state
                 q1[:] = qb
@@ -559,9 +591,16 @@ def run_kernel(
             wdd[:] = wdd1
             lam[:] = lam1
             if frac_end >= 1.0:
+                if not full:
+                    # a short final sub-step amplifies round-off in the Newmark acceleration
+                    # update; restore accelerations from equilibrium (same forces lam)
+                    for i in range(n):
+                        tmpn[i] = pext[step + 1, i]
+                    _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag[step + 1], tmpn, lam,
+                                 qdd, wdd)
                 break
             # --- transition at t_e = (step + tau_end) dt
-            t_e = (step + tau_end) * dt
+            t_e = t_offset + (step + tau_end) * dt
             ag_e = _interp(ag[step], ag[step + 1], tau_end)
             for i in range(n):
                 tmpn[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
@@ -630,4 +669,11 @@ def run_kernel(
             break
     if n_ev > max_events and status == STATUS_OK:
         status = STATUS_EVENT_OVERFLOW
+    w_state[:] = w
+    wd_state[:] = wd
+    stuck_state[:] = stuck
+    sig_state[:] = sig
+    e_state[0] = E_in
+    e_state[1] = E_damp
+    e_state[2] = E_fric
     return status, n_ev, n_sub_total

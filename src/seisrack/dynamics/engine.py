@@ -9,6 +9,7 @@ and a step never "fails to converge". See ``docs/theory/stick_slip_engine.md``.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg
@@ -88,6 +89,8 @@ def simulate(
     track_energy: bool = True,
     max_events: int = 200_000,
     throw: bool = True,
+    progress: Callable[[int], None] | None = None,
+    chunk_steps: int | None = None,
 ) -> TimeHistory:
     """Time history of a linear structure carrying masses that may stick or slide.
 
@@ -106,6 +109,9 @@ def simulate(
     g : gravity [m/s²]. u0, v0 : (n,) initial structural state (sliders start stuck).
     backend : "auto" (numba if installed), "numba" or "python" (the pure-Python twin).
     throw : raise :class:`SolverError` on failure; otherwise return with ``status`` set.
+    progress : called with the number of steps just completed, after each chunk of
+        ``chunk_steps`` steps (default 2000 when ``progress`` is given); chunking does not change
+        the result, the contact state carries over exactly.
     """
     M = _square("M", M, None)
     n = M.shape[0]
@@ -170,6 +176,8 @@ def simulate(
     q0 = phi.T @ (M @ q_u0)
     qd0 = phi.T @ (M @ q_v0)
 
+    if chunk_steps is not None and (int(chunk_steps) != chunk_steps or chunk_steps < 1):
+        raise InputError("chunk_steps", chunk_steps, "an integer >= 1")
     kern = get_kernel(backend)
     used = "numba" if kern.__name__.endswith("_numba") else "python"
     out_q = np.empty((n_t, n))
@@ -180,16 +188,43 @@ def simulate(
     out_lam = np.empty((n_t, m))
     out_stuck = np.empty((n_t, m), dtype=np.bool_)
     out_energy = np.zeros((n_t, 5))
-    ev_time = np.empty(max_events)
-    ev_slider = np.empty(max_events, dtype=np.int64)
-    ev_kind = np.empty(max_events, dtype=np.int64)
-    status, n_ev, n_sub = kern.run_kernel(
-        np.ascontiguousarray(w2), cd, Cq, diag, P, sliders.mass, sliders.mu_static,
-        sliders.mu_dynamic, float(dt), np.ascontiguousarray(ag), np.ascontiguousarray(pext),
-        np.ascontiguousarray(N), q0, qd0, bool(track_energy), int(max_events), 64,
-        out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy,
-        ev_time, ev_slider, ev_kind,
-    )
+    ev_time = np.empty(max_events + 1)
+    ev_slider = np.empty(max_events + 1, dtype=np.int64)
+    ev_kind = np.empty(max_events + 1, dtype=np.int64)
+    w2c = np.ascontiguousarray(w2)
+    ag = np.ascontiguousarray(ag)
+    pext = np.ascontiguousarray(pext)
+    N = np.ascontiguousarray(N)
+    w_state = np.zeros(m)
+    wd_state = np.zeros(m)
+    stuck_state = np.ones(m, dtype=np.bool_)
+    sig_state = np.ones(m)
+    e_state = np.zeros(3)
+    chunk = n_steps if chunk_steps is None and progress is None else int(chunk_steps or 2000)
+    status, n_ev, n_sub = 0, 0, 0
+    start = 0
+    while start < n_steps:
+        stop = min(start + chunk, n_steps)
+        rows = slice(start, stop + 1)
+        qs = q0 if start == 0 else out_q[start].copy()
+        qds = qd0 if start == 0 else out_qd[start].copy()
+        st, ne, ns = kern.run_kernel(
+            w2c, cd, Cq, diag, P, sliders.mass, sliders.mu_static, sliders.mu_dynamic,
+            float(dt), ag[rows], pext[rows], N[rows], qs, qds,
+            start > 0, w_state, wd_state, stuck_state, sig_state, e_state, start * float(dt),
+            bool(track_energy), max(int(max_events) - n_ev, 0), 64,
+            out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows], out_wd[rows],
+            out_lam[rows], out_stuck[rows], out_energy[rows],
+            ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
+        )
+        n_ev += int(ne)
+        n_sub += int(ns)
+        status = int(st)
+        if status != 0:
+            break
+        if progress is not None:
+            progress(stop - start)
+        start = stop
     status_text = _STATUS.get(int(status), f"status {status}")
     if status != 0:
         msg = f"stick-slip integration stopped: {status_text}"
