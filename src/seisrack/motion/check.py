@@ -1,0 +1,140 @@
+"""EN 1998-1 §3.2.3.1.2 compliance of a suite of accelerograms with a target spectrum.
+
+Checks, each reported pass/fail with its numbers:
+
+- §3.2.3.1.2(3): at least 3 accelerograms;
+- §3.2.3.1.2(4)a: mean of the records' peak ground accelerations ≥ a_g·S (the target's zero-period
+  value);
+- §3.2.3.1.2(4)b: in the period range [0.2·T1, 2·T1], no value of the mean 5 %-damped elastic
+  spectrum of the suite is below 90 % of the target;
+- §3.2.3.1.2(4): stationary part of each record ≥ 10 s. For a synthetic record the envelope's
+  plateau (``meta["stationary_duration_s"]``) is used; for others (e.g. files) it is estimated
+  as the time between the first and last instants where the 2 s moving RMS acceleration reaches
+  half its maximum (-6 dB). EC8 gives no measure; this estimate is ours and is approximate
+  (it counts part of the ramps of a trapezoidal envelope).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from seisrack.errors import InputError
+from seisrack.motion.ec8 import DesignSpectrum
+from seisrack.motion.records import Record
+from seisrack.motion.spectra import response_spectrum
+
+
+@dataclass(frozen=True)
+class CheckItem:
+    """One check: ``name``, ``passed``, the measured ``value``, the ``required`` bound, a note."""
+
+    name: str
+    passed: bool
+    value: float
+    required: float
+    note: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class SuiteReport:
+    """Result of :func:`check_ec8_suite`; ``passed`` is True when every check passes.
+
+    ``periods`` (n,) [s], ``mean_psa`` and ``target_psa`` (n,) [m/s²] cover [0.2·T1, 2·T1].
+    """
+
+    items: list[CheckItem]
+    periods: np.ndarray
+    mean_psa: np.ndarray
+    target_psa: np.ndarray
+    records: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return all(i.passed for i in self.items)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        return {
+            "passed": self.passed,
+            "checks": [vars(i) for i in self.items],
+            "records": self.records,
+            "periods_s": self.periods,
+            "mean_psa_m_s2": self.mean_psa,
+            "target_psa_m_s2": self.target_psa,
+        }
+
+    def text(self) -> str:
+        """Plain-text report, one line per check."""
+        lines = []
+        for i in self.items:
+            flag = "PASS" if i.passed else "FAIL"
+            lines.append(f"[{flag}] {i.name}: {i.value:.4g} (required {i.required:.4g}) {i.note}")
+        lines.append("suite " + ("complies" if self.passed else "does NOT comply"))
+        return "\n".join(lines)
+
+
+def stationary_duration(record: Record) -> float:
+    """[s] stationary duration: envelope plateau if known, else from the 2 s moving RMS."""
+    meta = record.meta or {}
+    if "stationary_duration_s" in meta:
+        return float(meta["stationary_duration_s"])
+    win = max(1, int(round(2.0 / record.dt)))
+    rms = np.sqrt(np.convolve(record.accel**2, np.ones(win) / win, mode="same"))
+    above = np.flatnonzero(rms >= 0.5 * rms.max())
+    return float((above[-1] - above[0]) * record.dt) if above.size else 0.0
+
+
+def check_ec8_suite(
+    records: Sequence[Record],
+    target: DesignSpectrum,
+    period: float,
+    *,
+    n_periods: int = 60,
+    min_stationary: float = 10.0,
+) -> SuiteReport:
+    """EC8 §3.2.3.1.2 report for ``records`` against ``target`` with fundamental period T1.
+
+    Args:
+        records: the suite, accelerations in m/s².
+        target: the elastic spectrum (e.g. ``ec8_spectrum(1, "C", 0.3)``); its damping is used.
+        period: [s] fundamental period T1 of the structure.
+    """
+    if not records:
+        raise InputError("records", 0, "at least one record")
+    if not (isinstance(period, int | float) and period > 0):
+        raise InputError("period", period, "a fundamental period T1 > 0 s")
+    T = np.geomspace(0.2 * period, 2.0 * period, n_periods)
+    spectra = np.array(
+        [response_spectrum(r.accel, r.dt, T, target.damping).psa for r in records]
+    )
+    mean = spectra.mean(axis=0)
+    tgt = target.psa(T)
+    ratio = mean / tgt
+    pgas = np.array([r.pga for r in records])
+    stats = np.array([stationary_duration(r) for r in records])
+    k = int(np.argmin(ratio))
+    items = [
+        CheckItem("number of records", len(records) >= 3, len(records), 3, "§3.2.3.1.2(3)"),
+        CheckItem(
+            "mean PGA / (ag·S)", bool(pgas.mean() >= target.pga), pgas.mean() / target.pga, 1.0,
+            f"mean PGA {pgas.mean():.4g} m/s2 vs {target.pga:.4g} m/s2, §3.2.3.1.2(4)a",
+        ),
+        CheckItem(
+            "min mean/target spectrum in [0.2 T1, 2 T1]", bool(ratio.min() >= 0.9),
+            float(ratio.min()), 0.9,
+            f"at T = {T[k]:.3g} s, range {T[0]:.3g}-{T[-1]:.3g} s, §3.2.3.1.2(4)b",
+        ),
+        CheckItem(
+            "shortest stationary part [s]", bool(stats.min() >= min_stationary),
+            float(stats.min()), min_stationary, "§3.2.3.1.2(4)",
+        ),
+    ]
+    recs = [
+        {"name": r.name, "pga_m_s2": p, "stationary_s": s, "duration_s": r.duration}
+        for r, p, s in zip(records, pgas, stats, strict=True)
+    ]
+    return SuiteReport(items, T, mean, tgt, recs)
