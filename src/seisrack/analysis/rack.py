@@ -1,0 +1,353 @@
+"""Earthquake time history of a rack with sliding pallets (paper §IV).
+
+Glue from a compiled :class:`~seisrack.model.frame_model.FrameModel` and a ground-motion
+:class:`~seisrack.motion.records.Record` to the stick–slip engine, and from the engine's
+:class:`~seisrack.dynamics.results.TimeHistory` to the quantities a rack engineer reads:
+beam-level displacement and acceleration, total pallet–beam contact force, base shear, upright
+moments, and each pallet's sliding against its fall limit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from seisrack.dynamics import Event, Sliders, TimeHistory, simulate
+from seisrack.errors import InputError
+from seisrack.fe.recovery import base_reactions, upright_moments
+from seisrack.model.frame_model import FrameModel
+from seisrack.motion.records import Record
+
+#: sliding below this [m] counts as "no sliding" (round-off of an exact zero)
+SLIDING_TOL_M = 1e-6
+#: default upper bound of the analysis time step [s]
+DEFAULT_MAX_DT = 0.005
+#: friction coefficient used for the companion run with rigidly held pallets
+RIGID_MU = 1.0e6
+
+
+@dataclass(frozen=True)
+class RackResponse:
+    """Response of a rack to one ground motion. Motion is relative to the ground.
+
+    t: (n_t,) [s]; ground_accel: (n_t,) [m/s²] (interpolated onto the analysis grid).
+    beam_displacement: (n_t, n_level) [m] mean horizontal displacement of each beam level.
+    beam_acceleration: (n_t, n_level) [m/s²] absolute horizontal acceleration of each level.
+    contact_force: (n_t, n_level) [N] total horizontal force of the beams on the pallets.
+    base_shear: (n_t,) [N] total horizontal support reaction (elastic + stiffness-proportional
+        damping forces), positive opposing positive ground displacement.
+    upright_moment_base: (n_t, n_upright) [N·m]; upright_moment_connection: (n_t, n_upright,
+        n_level) [N·m] largest-magnitude end moment of the upright segments at each connection.
+    pallet_sliding: (n_t, m) [m] each pallet relative to its beam; pallet_friction: (n_t, m) [N].
+    """
+
+    t: np.ndarray
+    ground_accel: np.ndarray
+    beam_displacement: np.ndarray
+    beam_acceleration: np.ndarray
+    contact_force: np.ndarray
+    base_shear: np.ndarray
+    upright_moment_base: np.ndarray
+    upright_moment_connection: np.ndarray
+    pallet_sliding: np.ndarray
+    pallet_friction: np.ndarray
+    pallet_level: np.ndarray
+    pallet_x: np.ndarray
+    pallet_mass: np.ndarray
+    pallet_mu_static: np.ndarray
+    pallet_mu_dynamic: np.ndarray
+    pallet_limit_neg: np.ndarray
+    pallet_limit_pos: np.ndarray
+    events: list[Event]
+    energy: dict[str, np.ndarray]
+    g: float
+    dt: float
+    record_name: str
+    status: str
+    history: TimeHistory = field(repr=False)
+    rigid_beam_acceleration_peak: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ derived results
+    @property
+    def n_pallets(self) -> int:
+        return int(self.pallet_mass.size)
+
+    def pallet_labels(self) -> list[str]:
+        return [
+            f"P{j + 1} (level {int(self.pallet_level[j]) + 1}, x = {self.pallet_x[j]:.3f} m)"
+            for j in range(self.n_pallets)
+        ]
+
+    def pallet_peak_sliding(self) -> np.ndarray:
+        """(m,) [m] peak |sliding| of each pallet."""
+        if self.n_pallets == 0:
+            return np.zeros(0)
+        return np.max(np.abs(self.pallet_sliding), axis=0)
+
+    def pallet_residual(self) -> np.ndarray:
+        """(m,) [m] sliding at the end of the record."""
+        if self.n_pallets == 0:
+            return np.zeros(0)
+        return self.pallet_sliding[-1].copy()
+
+    def fall_utilisation(self) -> np.ndarray:
+        """(m,) largest ratio of sliding to the free distance on the side it slid towards."""
+        if self.n_pallets == 0:
+            return np.zeros(0)
+        pos = np.max(self.pallet_sliding, axis=0).clip(0.0)
+        neg = (-np.min(self.pallet_sliding, axis=0)).clip(0.0)
+        return np.maximum(_ratio(pos, self.pallet_limit_pos), _ratio(neg, self.pallet_limit_neg))
+
+    def pallets_at_risk(self) -> list[int]:
+        """0-based indices of pallets whose sliding reached their free distance (may fall)."""
+        return [int(j) for j in np.flatnonzero(self.fall_utilisation() >= 1.0)]
+
+    def sliding_occurred(self) -> bool:
+        return bool(np.any(self.pallet_peak_sliding() > SLIDING_TOL_M))
+
+    def simplified_check(self) -> dict[str, Any]:
+        """The paper's §II/§IV rule "no sliding if mu >= alpha" checked against this run.
+
+        alpha is the peak absolute beam acceleration over g of the level a pallet stands on,
+        taken from the companion run with rigidly held pallets (what a designer computes without
+        a sliding model), and also reported for this run.
+        """
+        alpha_run = np.max(np.abs(self.beam_acceleration), axis=0) / self.g
+        alpha_rigid = (
+            self.rigid_beam_acceleration_peak / self.g
+            if self.rigid_beam_acceleration_peak is not None
+            else alpha_run
+        )
+        lv = self.pallet_level
+        predicted = self.pallet_mu_static < alpha_rigid[lv]
+        slid = self.pallet_peak_sliding() > SLIDING_TOL_M
+        unsafe = slid & ~predicted
+        return {
+            "rule": "no sliding if mu_static >= alpha = peak beam acceleration / g",
+            "alpha_rigid": alpha_rigid.tolist(),
+            "alpha_this_run": alpha_run.tolist(),
+            "predicted_sliding": predicted.tolist(),
+            "sliding": slid.tolist(),
+            "rule_safe": bool(not np.any(unsafe)),
+            "rule_conservative_by": (alpha_rigid[lv] - self.pallet_mu_static).tolist(),
+        }
+
+    def peaks(self) -> dict[str, Any]:
+        """Peak values (JSON-ready), the issue #5 ``--json`` schema plus extra fields."""
+        disp = np.max(np.abs(self.beam_displacement), axis=0)
+        acc = np.max(np.abs(self.beam_acceleration), axis=0)
+        force = np.max(np.abs(self.contact_force), axis=0)
+        mb = np.max(np.abs(self.upright_moment_base))
+        conn = self.upright_moment_connection
+        mc = np.max(np.abs(conn)) if conn.size else 0.0
+        return {
+            "beam_displacement_m": float(disp.max()),
+            "beam_acceleration_m_s2": float(acc.max()),
+            "total_friction_force_N": float(np.max(np.abs(self.contact_force.sum(axis=1)))),
+            "base_shear_N": float(np.max(np.abs(self.base_shear))),
+            "upright_moment_base_Nm": float(mb),
+            "upright_moment_connection_Nm": float(mc),
+            "pallet_sliding_m": self.pallet_peak_sliding().tolist(),
+            "pallet_residual_m": self.pallet_residual().tolist(),
+            "per_level": {
+                "beam_displacement_m": disp.tolist(),
+                "beam_acceleration_m_s2": acc.tolist(),
+                "contact_force_N": force.tolist(),
+            },
+        }
+
+    def summary(self) -> dict[str, Any]:
+        """Everything the CLI prints with ``--json``."""
+        n_slip = sum(1 for e in self.events if e.kind == "slip")
+        return {
+            "record": self.record_name,
+            "g_m_s2": self.g,
+            "dt_s": self.dt,
+            "duration_s": float(self.t[-1]),
+            "status": self.status,
+            "peaks": self.peaks(),
+            "sliding_occurred": self.sliding_occurred(),
+            "pallets_at_risk": self.pallets_at_risk(),
+            "pallets": [
+                {
+                    "label": lab,
+                    "mass_kg": float(self.pallet_mass[j]),
+                    "mu_static": float(self.pallet_mu_static[j]),
+                    "mu_dynamic": float(self.pallet_mu_dynamic[j]),
+                    "peak_sliding_m": float(self.pallet_peak_sliding()[j]),
+                    "residual_m": float(self.pallet_residual()[j]),
+                    "limit_neg_m": float(self.pallet_limit_neg[j]),
+                    "limit_pos_m": float(self.pallet_limit_pos[j]),
+                    "fall_utilisation": float(self.fall_utilisation()[j]),
+                    "sliding_phases": self.history.sliding_phases(j),
+                }
+                for j, lab in enumerate(self.pallet_labels())
+            ],
+            "simplified_check": self.simplified_check(),
+            "n_events": len(self.events),
+            "n_slip_events": n_slip,
+            "energy_balance_error": self.history.energy_error() if self.energy else None,
+        }
+
+
+def _ratio(demand: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """demand / limit, with 0/0 = 0 and x/0 = inf (a pallet with no free distance)."""
+    out = np.zeros_like(demand)
+    ok = limit > 0
+    out[ok] = demand[ok] / limit[ok]
+    out[~ok & (demand > SLIDING_TOL_M)] = np.inf
+    return out
+
+
+def analysis_grid(record: Record, dt: float | None, max_dt: float = DEFAULT_MAX_DT) -> int:
+    """Number of analysis steps per record step (the analysis dt is ``record.dt / k``)."""
+    if dt is None:
+        return max(1, math.ceil(record.dt / max_dt - 1e-9))
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise InputError("dt", dt, "a finite time step > 0 s")
+    ratio = record.dt / dt
+    k = round(ratio)
+    if k < 1 or abs(ratio - k) > 1e-6 * max(ratio, 1.0):
+        raise InputError(
+            "dt", dt,
+            f"the record's time step {record.dt:g} s divided by a whole number "
+            f"(e.g. {record.dt:g}, {record.dt / 2:g}, {record.dt / 4:g} s)",
+        )
+    return int(k)
+
+
+def _resample(a: np.ndarray, k: int) -> np.ndarray:
+    """Linear interpolation of a record onto ``k`` sub-steps per record step (exact for the
+    piecewise-linear excitation the engine assumes)."""
+    if k == 1:
+        return np.asarray(a, dtype=float)
+    n = a.size
+    x = np.arange((n - 1) * k + 1) / k
+    return np.interp(x, np.arange(n), a)
+
+
+def run_rack(
+    model: FrameModel,
+    record: Record,
+    *,
+    dt: float | None = None,
+    vertical: Record | None = None,
+    free_vibration: float = 0.0,
+    backend: str = "auto",
+    rigid_companion: bool = True,
+    progress: Callable[[int], None] | None = None,
+    throw: bool = True,
+) -> RackResponse:
+    """Time history of ``model`` under the horizontal ground acceleration ``record``.
+
+    dt: analysis step [s], a whole divisor of ``record.dt`` (default: the largest such step
+        ≤ 5 ms). vertical: optional vertical ground acceleration (same dt and length); the
+        pallets' normal forces become m (g + a_v) and the structure is loaded vertically.
+    free_vibration: seconds of zero ground motion appended after the record.
+    rigid_companion: also run the rack with rigidly held pallets (for the simplified check).
+    progress: called with the number of analysis steps completed (for progress bars).
+    """
+    if not isinstance(record, Record):
+        raise InputError("record", type(record).__name__, "a seisrack.motion.Record")
+    if record.accel.size < 3:
+        raise InputError(
+            "record", f"{record.accel.size} samples", "a record of at least 3 samples"
+        )
+    if not (math.isfinite(free_vibration) and free_vibration >= 0):
+        raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
+    k = analysis_grid(record, dt)
+    h = record.dt / k
+    ag_rec = np.asarray(record.accel, dtype=float)
+    av_rec = None
+    if vertical is not None:
+        if abs(vertical.dt - record.dt) > 1e-9 * record.dt:
+            raise InputError(
+                "vertical.dt", vertical.dt, f"the horizontal record's time step {record.dt:g} s"
+            )
+        if vertical.accel.size != record.accel.size:
+            raise InputError(
+                "vertical", f"{vertical.accel.size} samples",
+                f"the horizontal record's length ({record.accel.size} samples)",
+            )
+        av_rec = np.asarray(vertical.accel, dtype=float)
+    n_pad = int(round(free_vibration / record.dt))
+    if n_pad:
+        ag_rec = np.concatenate([ag_rec, np.zeros(n_pad)])
+        if av_rec is not None:
+            av_rec = np.concatenate([av_rec, np.zeros(n_pad)])
+    ag = _resample(ag_rec, k)
+    av = None if av_rec is None else _resample(av_rec, k)
+    sliders = Sliders(
+        model.pallet_dof, model.pallet_mass, model.pallet_mu_static, model.pallet_mu_dynamic
+    )
+    hist = simulate(
+        model.M, model.C, model.K, sliders, dt=h, ground_accel=ag, influence=model.r_x,
+        vertical_accel=av, vertical_influence=None if av is None else model.r_y, g=model.g,
+        backend=backend, throw=throw, progress=progress,
+    )
+    rigid_peak = None
+    if rigid_companion and model.n_pallets:
+        rigid = simulate(
+            model.M, model.C, model.K,
+            Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU),
+            dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
+            vertical_influence=None if av is None else model.r_y, g=model.g, backend=backend,
+            throw=throw, track_energy=False,
+        )
+        rigid_peak = np.array([
+            np.max(np.abs(rigid.dof_response(d, "a").mean(axis=1) + ag)) for d in model.level_dofs
+        ])
+    return _response(model, hist, ag, h, record.name, rigid_peak)
+
+
+def _response(
+    model: FrameModel, hist: TimeHistory, ag: np.ndarray, h: float, name: str,
+    rigid_peak: np.ndarray | None,
+) -> RackResponse:
+    U = hist.u
+    disp = np.stack([U[:, d].mean(axis=1) for d in model.level_dofs], axis=1)
+    acc = np.stack([hist.a[:, d].mean(axis=1) + ag for d in model.level_dofs], axis=1)
+    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+    pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
+    n_level = len(model.level_dofs)
+    force = np.zeros((U.shape[0], n_level))
+    for j, lv in enumerate(pallet_level):
+        force[:, lv] += hist.friction[:, j]
+    # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
+    # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
+    a1 = float(model.damping_coefficients[1])
+    reac = base_reactions(model, U + a1 * hist.v)
+    base_shear = -reac[..., 0].sum(axis=-1)
+    mom = upright_moments(model, U)
+    conn = np.where(np.abs(mom.below) >= np.abs(mom.above), mom.below, mom.above)
+    return RackResponse(
+        t=hist.t,
+        ground_accel=ag,
+        beam_displacement=disp,
+        beam_acceleration=acc,
+        contact_force=force,
+        base_shear=base_shear,
+        upright_moment_base=mom.base,
+        upright_moment_connection=conn,
+        pallet_sliding=hist.sliding,
+        pallet_friction=hist.friction,
+        pallet_level=pallet_level,
+        pallet_x=np.asarray(model.nodes[model.pallet_node, 0], dtype=float),
+        pallet_mass=np.asarray(model.pallet_mass, dtype=float),
+        pallet_mu_static=np.asarray(model.pallet_mu_static, dtype=float),
+        pallet_mu_dynamic=np.asarray(model.pallet_mu_dynamic, dtype=float),
+        pallet_limit_neg=np.asarray(model.pallet_limit_neg, dtype=float),
+        pallet_limit_pos=np.asarray(model.pallet_limit_pos, dtype=float),
+        events=hist.events,
+        energy=hist.energy,
+        g=float(model.g),
+        dt=h,
+        record_name=name,
+        status=hist.status,
+        history=hist,
+        rigid_beam_acceleration_peak=rigid_peak,
+    )
