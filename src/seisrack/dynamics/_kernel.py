@@ -43,6 +43,66 @@ STATUS_NONFINITE = 3
 
 
 @_JIT
+def _solve(A, B):
+    """Solve A X = B by Gaussian elimination with partial pivoting; A (k, k), B (k, r).
+
+    Hand-written (instead of np.linalg) to keep numba compile times short; k is small here
+    (number of stuck sliders) or the modal size for non-classical damping only.
+    """
+    k = A.shape[0]
+    r = B.shape[1]
+    a = A.copy()
+    x = B.copy()
+    for c in range(k):
+        piv = c
+        big = abs(a[c, c])
+        for i in range(c + 1, k):
+            if abs(a[i, c]) > big:
+                big = abs(a[i, c])
+                piv = i
+        if piv != c:
+            for j in range(k):
+                tmp = a[c, j]
+                a[c, j] = a[piv, j]
+                a[piv, j] = tmp
+            for j in range(r):
+                tmp = x[c, j]
+                x[c, j] = x[piv, j]
+                x[piv, j] = tmp
+        d = a[c, c]
+        for i in range(c + 1, k):
+            f = a[i, c] / d
+            if f != 0.0:
+                for j in range(c, k):
+                    a[i, j] -= f * a[c, j]
+                for j in range(r):
+                    x[i, j] -= f * x[c, j]
+    for c in range(k - 1, -1, -1):
+        for j in range(r):
+            acc = x[c, j]
+            for i in range(c + 1, k):
+                acc -= a[c, i] * x[i, j]
+            x[c, j] = acc / a[c, c]
+    return x
+
+
+@_JIT
+def _mm_pt(A, P):
+    """A @ P.T for A (k, n), P (m, n): shape (k, m)."""
+    k = A.shape[0]
+    m = P.shape[0]
+    n = P.shape[1]
+    out = np.empty((k, m))
+    for i in range(k):
+        for j in range(m):
+            acc = 0.0
+            for t in range(n):
+                acc += A[i, t] * P[j, t]
+            out[i, j] = acc
+    return out
+
+
+@_JIT
 def _interp(x0, x1, theta):
     return x0 + theta * (x1 - x0)
 
@@ -58,7 +118,9 @@ def _modal_solve(kd, cd, Cq, diag, h, rhs, out):
         Kh = (2.0 / h) * Cq.copy()
         for i in range(n):
             Kh[i, i] += kd[i] + 4.0 / (h * h)
-        out[:] = np.linalg.solve(Kh, rhs)
+        x = _solve(Kh, rhs.reshape((n, 1)))
+        for i in range(n):
+            out[i] = x[i, 0]
 
 
 @_JIT
@@ -76,7 +138,7 @@ def _hmat_pt(kd, cd, Cq, diag, h, P):
     Kh = (2.0 / h) * Cq.copy()
     for i in range(n):
         Kh[i, i] += kd[i] + 4.0 / (h * h)
-    return np.ascontiguousarray(np.linalg.solve(Kh, np.ascontiguousarray(P.T)))
+    return _solve(Kh, np.ascontiguousarray(P.T))
 
 
 @_JIT
@@ -85,7 +147,7 @@ def _damp_mul(cd, Cq, diag, x, out):
         for i in range(x.shape[0]):
             out[i] = cd[i] * x[i]
     else:
-        out[:] = Cq @ x
+        _mv(Cq, x, out)
 
 
 @_JIT
@@ -157,7 +219,7 @@ def _trial(
                 for c in range(n_stuck):
                     Ass[a, c] = c2 * G[idx[a], idx[c]]
                 Ass[a, a] += 0.5 * h / mass[idx[a]]
-            Ainv_cache[:n_stuck, :n_stuck] = np.linalg.inv(Ass)
+            Ainv_cache[:n_stuck, :n_stuck] = _solve(Ass, np.eye(n_stuck))
             recomputed = True
         for a in range(n_stuck):
             acc = 0.0
@@ -226,7 +288,8 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
     base = np.empty(n)  # structural acceleration without slider forces
     for i in range(n):
         base[i] = pext[i] - tmp[i] - kd[i] * q[i]
-    pb = P @ base
+    pb = np.empty(m)
+    _mv(P, base, pb)
     sdot0 = np.empty(m)
     for j in range(m):
         sdot0[j] = -ag - pb[j]
@@ -259,7 +322,7 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
                 r[a] = -acc
                 for c in range(n_stuck):
                     Bss[a, c] = B[idx[a], idx[c]]
-            x = np.linalg.solve(Bss, r)
+            x = _solve(Bss, r.reshape((n_stuck, 1)))[:, 0]
             for a in range(n_stuck):
                 lam[idx[a]] = x[a]
         # release the most overloaded stuck slider, one at a time
@@ -279,7 +342,8 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
             break
         stuck[worst] = False
         sig[worst] = -1.0 if lam[worst] > 0.0 else 1.0
-    ptl = np.ascontiguousarray(P.T) @ lam
+    ptl = np.empty(n)
+    _mv(np.ascontiguousarray(P.T), lam, ptl)
     for i in range(n):
         qdd[i] = base[i] - ptl[i]
     for j in range(m):
@@ -311,8 +375,8 @@ def run_kernel(
     n_t = ag.shape[0]
     # operators for the regular step
     HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, P)
-    G_dt = P @ HPt_dt
-    B = P @ np.ascontiguousarray(P.T)
+    G_dt = _mm_pt(P, np.ascontiguousarray(HPt_dt.T))
+    B = _mm_pt(P, P)
     for j in range(m):
         B[j, j] += 1.0 / mass[j]
     # state
@@ -331,8 +395,10 @@ def run_kernel(
         E_damp = e_state[1]
         E_fric = e_state[2]
     else:
-        w = P @ q
-        wd = P @ qd
+        w = np.empty(m)
+        wd = np.empty(m)
+        _mv(P, q, w)
+        _mv(P, qd, wd)
         stuck = np.ones(m, dtype=np.bool_)
         sig = np.ones(m)
         E_in = 0.0
@@ -433,7 +499,7 @@ def run_kernel(
                     cache_ok = True
             else:
                 HPt = _hmat_pt(kd, cd, Cq, diag, hrem, P)
-                G = P @ HPt
+                G = _mm_pt(P, np.ascontiguousarray(HPt.T))
                 _trial(
                     hrem, kd, cd, Cq, diag, P, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd,
                     ag1, pe1, N[step + 1], stuck, sig, Ainv, False,
@@ -512,7 +578,7 @@ def run_kernel(
                     ag_e = _interp(ag[step], ag[step + 1], frac_end)
                     N_e = N[step] + frac_end * (N[step + 1] - N[step])
                     HPt = _hmat_pt(kd, cd, Cq, diag, hsub, P)
-                    G = P @ HPt
+                    G = _mm_pt(P, np.ascontiguousarray(HPt.T))
                     _trial(
                         hsub, kd, cd, Cq, diag, P, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd,
                         ag_e, tmpn, N_e, stuck, sig, Ainv, False,
@@ -608,7 +674,8 @@ def run_kernel(
             _event_values(stuck, sig, lam, N_e, s1, mus, e_try)
             old_stuck = stuck.copy()
             old_sig = sig.copy()
-            vn = P @ qd
+            vn = np.empty(m)
+            _mv(P, qd, vn)
             for j in range(m):
                 cand[j] = False
                 forced[j] = False
