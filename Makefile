@@ -14,6 +14,7 @@ $(BIN)/python:
 
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[all,test]'
+	$(BIN)/python -m seisrack._warmup
 	touch $(STAMP)
 
 install: $(STAMP)
