@@ -15,9 +15,9 @@ Formulation (see ``docs/theory/stick_slip_engine.md``):
   fixed: stuck sliders satisfy zero relative velocity at the end of the step, sliding sliders carry
   ``lam = -mu_d N sign(s)``. The stuck forces solve a small SPD system ``A_SS lam_S = -b_S``.
 * Transitions are located *inside* the step: an event function per slider (``|lam| - mu_s N`` for
-  stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by Illinois regula falsi on the
-  sub-step length, the step is split there, and the new contact state is decided at the
-  acceleration level (active set on ``B = diag(1/m) + P P^T``).
+  stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by regula falsi (with a
+  bisection safeguard) on the sub-step length, the step is split there, and the new contact
+  state is decided at the acceleration level (active set on ``B = diag(1/m) + P P^T``).
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)

@@ -21,6 +21,10 @@ from seisrack.errors import InputError, SolverError
 
 _LOG = logging.getLogger(__name__)
 
+#: cap on sub-steps (event splits) inside one time step; slip-onset chatter with mu_d = mu_s
+#: can produce dozens of micro-events in one step on multi-pallet racks
+_MAX_SUBSTEPS = 512
+
 _STATUS = {
     0: "ok",
     1: "event buffer overflow (increase max_events)",
@@ -156,7 +160,7 @@ def simulate(
     cq = phi.T @ C @ phi
     off = cq - np.diag(np.diag(cq))
     diag = bool(np.max(np.abs(off)) <= 1e-10 * max(np.max(np.abs(np.diag(cq))), 1e-300))
-    cd = np.ascontiguousarray(np.diag(cq)) if diag else np.zeros(n)
+    cd = np.diag(cq).copy() if diag else np.zeros(n)  # writable: one numba specialisation
     Cq = np.zeros((1, 1)) if diag else np.ascontiguousarray(cq)
     gamma = phi.T @ (M @ r)
     pext = -np.outer(ag, gamma)
@@ -212,7 +216,7 @@ def simulate(
             w2c, cd, Cq, diag, P, sliders.mass, sliders.mu_static, sliders.mu_dynamic,
             float(dt), ag[rows], pext[rows], N[rows], qs, qds,
             start > 0, w_state, wd_state, stuck_state, sig_state, e_state, start * float(dt),
-            bool(track_energy), max(int(max_events) - n_ev, 0), 64,
+            bool(track_energy), max(int(max_events) - n_ev, 0), _MAX_SUBSTEPS,
             out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows], out_wd[rows],
             out_lam[rows], out_stuck[rows], out_energy[rows],
             ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],

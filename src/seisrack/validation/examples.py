@@ -178,9 +178,14 @@ def summarize(u: np.ndarray, sliding: np.ndarray, events: Any) -> dict[str, Any]
     }
 
 
+_ZERO = 1e-12  # [m] below this a peak is round-off (a case that never slides)
+
+
 def _rel(a: float, b: float) -> float:
-    scale = max(abs(b), 1e-12)
-    return abs(a - b) / scale
+    """Relative difference of ``a`` to ``b``; 0 when both are round-off around zero."""
+    if abs(a) < _ZERO and abs(b) < _ZERO:
+        return 0.0
+    return abs(a - b) / max(abs(b), _ZERO)
 
 
 def _resolve_engine(engine: Any) -> Callable[..., Any] | None:
