@@ -1,0 +1,340 @@
+"""``seisrack run RACK.toml --motion FILE``: earthquake time history of a rack (issue #5).
+
+Thin: parse and check the options, load the rack and the record, call
+:func:`seisrack.analysis.run_rack`, print a summary or the ``--json`` object, and write the
+results with :mod:`seisrack.report.rack_io` and :mod:`seisrack.report.rack_plot`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+#: runs with more analysis steps than this show a progress bar (when stderr is a terminal)
+PROGRESS_MIN_STEPS = 20_000
+
+_OUT_HELP = (
+    "folder for the results (created if needed): timehistory.nc (netCDF, all time histories), "
+    "peaks.csv, summary.json and, with --plot (the default with --out), "
+    "fig16a_displacement.png, fig16b_acceleration.png, fig16c_contact_force.png, "
+    "fig16d_sliding.png. Files of these names are overwritten; nothing else in the folder is "
+    "touched"
+)
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "run", help="earthquake time history of a rack with sliding pallets",
+        description="Apply a horizontal ground acceleration at the supports of a rack and "
+                    "report the beam displacement and acceleration, the pallet-beam contact "
+                    "force, base shear, upright moments, and each pallet's sliding against its "
+                    "fall limit (paper §IV). Units: SI (m, s, kg, N).")
+    p.add_argument("rack", help="rack description (TOML)")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--motion", metavar="FILE",
+                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
+    src.add_argument("--builtin", metavar="NAME",
+                     help="a bundled record instead of --motion (e.g. elcentro_1940_ns)")
+    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2' (not needed for "
+                                   ".AT2 or seisrack CSV files)")
+    p.add_argument("--motion-dt", type=float, metavar="DT",
+                   help="[s] time step of a one-column record file")
+    p.add_argument("--vertical", metavar="FILE",
+                   help="vertical ground acceleration, same units, dt and length as the "
+                        "horizontal record (pallet normal forces become m (g + a_v))")
+    p.add_argument("--mu", type=float, metavar="MU",
+                   help="static friction coefficient of every pallet (overrides the file)")
+    p.add_argument("--mu-dynamic", type=float, metavar="MUD",
+                   help="dynamic friction coefficient of every pallet (default: --mu); "
+                        "needs --mu")
+    p.add_argument("--dt", type=float, metavar="DT",
+                   help="[s] analysis time step, the record dt divided by a whole number "
+                        "(default: the largest such step <= 5 ms)")
+    p.add_argument("--free-vibration", type=float, default=0.0, metavar="S",
+                   help="[s] of free vibration after the record (default 0)")
+    p.add_argument("--out", metavar="DIR", help=_OUT_HELP)
+    p.add_argument("--plot", action=argparse.BooleanOptionalAction, default=None,
+                   help="write the Fig. 16a-d PNGs into --out DIR (default: yes with --out)")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (the summary) instead of the text report")
+    p.set_defaults(func=run)
+
+
+# ------------------------------------------------------------------------------ validation
+def _check_number(name: str, value: float | None, allowed: str, ok: bool) -> None:
+    from seisrack.errors import InputError
+
+    if value is not None and not (math.isfinite(value) and ok):
+        raise InputError(name, value, allowed)
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    from seisrack.errors import InputError
+
+    _check_number("--mu", args.mu, "a friction coefficient >= 0",
+                  args.mu is not None and args.mu >= 0)
+    if args.mu_dynamic is not None:
+        if args.mu is None:
+            raise InputError("--mu-dynamic", args.mu_dynamic, "used together with --mu")
+        _check_number("--mu-dynamic", args.mu_dynamic, "a friction coefficient >= 0",
+                      args.mu_dynamic >= 0)
+        if args.mu_dynamic > args.mu:
+            raise InputError("--mu-dynamic", args.mu_dynamic, f"a value <= --mu ({args.mu:g})",
+                             hint="The dynamic friction coefficient cannot exceed the static one")
+    _check_number("--dt", args.dt, "a time step > 0 s", args.dt is not None and args.dt > 0)
+    _check_number("--motion-dt", args.motion_dt, "a time step > 0 s",
+                  args.motion_dt is not None and args.motion_dt > 0)
+    _check_number("--free-vibration", args.free_vibration, "a duration >= 0 s",
+                  args.free_vibration >= 0)
+    if args.plot and not args.out:
+        raise InputError("--plot", True, "used together with --out DIR (figures go there)")
+
+
+def _read(path: str, option: str, args: argparse.Namespace) -> Any:
+    from seisrack.errors import InputError
+    from seisrack.motion import read_record
+
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(option, path, "an existing record file (.AT2, or 1- or 2-column "
+                                       "text/CSV)",
+                         hint="Check the path" if not p.exists() else "It is not a file")
+    try:
+        return read_record(p, units=args.units, dt=args.motion_dt)
+    except InputError as exc:
+        # name the command-line option, not the library argument
+        cli = {"units": "--units", "dt": "--motion-dt"}.get(exc.field)
+        if cli is None or type(exc) is not InputError:
+            raise
+        raise InputError(cli, exc.value, exc.allowed, source=exc.source or path,
+                         hint=exc.hint) from None
+
+
+def _records(args: argparse.Namespace) -> tuple[Any, Any]:
+    from seisrack.errors import InputError
+    from seisrack.motion import list_builtin_records, load_builtin_record
+
+    if args.builtin is not None:
+        if args.builtin not in list_builtin_records():
+            raise InputError("--builtin", args.builtin, ", ".join(list_builtin_records()))
+        rec = load_builtin_record(args.builtin)
+    else:
+        rec = _read(args.motion, "--motion", args)
+    if rec.n < 3:
+        raise InputError("--motion", f"{rec.n} samples", "a record of at least 3 samples")
+    vert = None
+    if args.vertical is not None:
+        vert = _read(args.vertical, "--vertical", args)
+        if abs(vert.dt - rec.dt) > 1e-9 * rec.dt:
+            raise InputError("--vertical", f"time step {vert.dt:g} s",
+                             f"the horizontal record's time step ({rec.dt:g} s)")
+        if vert.n != rec.n:
+            raise InputError("--vertical", f"{vert.n} samples",
+                             f"the horizontal record's length ({rec.n} samples)")
+    return rec, vert
+
+
+def _prepare_out(out: str) -> Path:
+    """Create ``out`` if needed and check that seisrack may write there (before the run)."""
+    from seisrack.errors import InputError
+
+    p = Path(out)
+    if p.exists() and not p.is_dir():
+        raise InputError("--out", out, "a folder (this is an existing file)")
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError("--out", out, "a folder that can be created",
+                         hint=f"{exc.strerror or exc}") from None
+    probe = p / f".seisrack-write-test.{os.getpid()}"
+    try:
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError("--out", out, "a writable folder",
+                         hint=f"{exc.strerror or exc}") from None
+    return p
+
+
+def _need(module: str, option: str, value: Any, extra: str) -> None:
+    from seisrack.errors import InputError
+
+    try:
+        __import__(module)
+    except ImportError:
+        raise InputError(option, value, f"{module} installed",
+                         hint=f"Install it with: pip install 'seisrack[{extra}]'") from None
+
+
+# ------------------------------------------------------------------------------ run
+def run(args: argparse.Namespace) -> int:
+    from seisrack.analysis import analysis_grid, run_rack
+    from seisrack.cli._common import print_json
+    from seisrack.errors import InputError
+    from seisrack.model import compile_rack, load_rack, with_friction
+
+    _check_options(args)
+    spec = load_rack(args.rack)
+    if args.mu is not None:
+        spec = with_friction(spec, args.mu, args.mu_dynamic)
+    model = compile_rack(spec)
+    rec, vert = _records(args)
+    try:
+        k = analysis_grid(rec, args.dt)
+    except InputError as exc:
+        raise InputError("--dt", args.dt, exc.allowed) from None
+    plot = bool(args.out) if args.plot is None else bool(args.plot)
+    out = None
+    if args.out:
+        _need("xarray", "--out", args.out, "io")
+        if plot:
+            _need("matplotlib", "--plot", True, "plot")
+        out = _prepare_out(args.out)
+
+    n_pad = int(round(args.free_vibration / rec.dt))
+    n_steps = (rec.n - 1 + n_pad) * k
+    bar = _progress_bar(n_steps)
+    try:
+        resp = run_rack(model, rec, dt=rec.dt / k, vertical=vert,
+                        free_vibration=args.free_vibration,
+                        progress=None if bar is None else bar.update)
+    finally:
+        if bar is not None:
+            bar.close()
+
+    summary = resp.summary()
+    summary = {"rack": args.rack, "title": spec.title, **summary}
+    if out is not None:
+        _write_outputs(resp, model, spec, summary, out, plot)  # adds summary["outputs"]
+    if args.json:
+        print_json(summary)
+    else:
+        print(format_report(resp, spec, rec, vert, summary))
+    return 0
+
+
+def _progress_bar(n_steps: int) -> Any:
+    """A tqdm bar on stderr for long runs written to a terminal, else None."""
+    if n_steps <= PROGRESS_MIN_STEPS or not sys.stderr.isatty():
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=n_steps, unit="step", desc="time history", file=sys.stderr,
+                leave=False, dynamic_ncols=True)
+
+
+def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], out: Path,
+                   plot: bool) -> list[Path]:
+    from seisrack.report import rack_io
+
+    title = spec.title or Path(summary["rack"]).stem
+    written = [
+        rack_io.write_timehistory(resp, out / rack_io.TIMEHISTORY_FILE, model=model,
+                                  title=title, summary=summary),
+        rack_io.write_peaks_csv(resp, out / rack_io.PEAKS_FILE),
+    ]
+    if plot:
+        from seisrack.report.rack_plot import save_fig16
+
+        written += save_fig16(resp, out, suptitle=f"{title} - {resp.record_name}")
+    summary_path = out / rack_io.SUMMARY_FILE
+    written.append(summary_path)
+    summary["outputs"] = [str(p) for p in written]
+    rack_io.write_summary_json(summary, summary_path)
+    return written
+
+
+# ------------------------------------------------------------------------------ text report
+def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, Any]) -> str:
+    """The human-readable report printed without ``--json``."""
+    import numpy as np
+
+    pk = summary["peaks"]
+    g = resp.g
+    lines = [spec.title or summary["rack"]]
+    lines.append(
+        f"record: {rec.name} ({rec.n} samples, dt {rec.dt:g} s, PGA {rec.pga:.3f} m/s² = "
+        f"{rec.pga / 9.80665:.3f} g)" + (f", vertical: {vert.name}" if vert is not None else ""))
+    lines.append(f"analysis: dt {resp.dt:g} s, {resp.t.size - 1} steps, {resp.t[-1]:.2f} s, "
+                 f"g = {g:g} m/s², status {resp.status}, energy balance error "
+                 f"{summary['energy_balance_error']:.1e}")
+    lines.append("")
+    m_tot = float(np.sum(resp.pallet_mass)) if resp.n_pallets else 0.0
+    cap = float(np.sum(resp.pallet_mu_dynamic * resp.pallet_mass)) * g
+    rows = [
+        ("beam displacement (relative to ground)", pk["beam_displacement_m"] * 1e3, "mm"),
+        ("beam acceleration (absolute)", pk["beam_acceleration_m_s2"], "m/s²",
+         f"= {pk['beam_acceleration_m_s2'] / g:.3f} g"),
+        ("total pallet-beam contact force", pk["total_friction_force_N"] / 1e3, "kN",
+         f"(μd·M·g = {cap / 1e3:.3f} kN, M = {m_tot:.0f} kg)" if resp.n_pallets else ""),
+        ("base shear", pk["base_shear_N"] / 1e3, "kN"),
+        ("upright moment at the base", pk["upright_moment_base_Nm"] / 1e3, "kN·m"),
+        ("upright moment at the connections", pk["upright_moment_connection_Nm"] / 1e3,
+         "kN·m"),
+    ]
+    lines.append("Peaks")
+    for name, val, unit, *note in rows:
+        lines.append(f"  {name:<38} {val:>10.3f} {unit:<5} {note[0] if note else ''}".rstrip())
+    if len(pk["per_level"]["beam_displacement_m"]) > 1:
+        for lv, (d, a) in enumerate(zip(pk["per_level"]["beam_displacement_m"],
+                                        pk["per_level"]["beam_acceleration_m_s2"],
+                                        strict=True)):
+            lines.append(f"    level {lv + 1}: displacement {d * 1e3:.3f} mm, "
+                         f"acceleration {a:.3f} m/s²")
+    lines.append("")
+    if resp.n_pallets:
+        lines.append("Pallets (sliding relative to the beam; limit = free distance -x / +x)")
+        lines.append(f"  {'#':>3} {'level':>5} {'x [m]':>7} {'mass [kg]':>9} {'mu_s':>5} "
+                     f"{'mu_d':>5} {'peak [mm]':>10} {'residual [mm]':>13} "
+                     f"{'limit [mm]':>15} {'utilisation':>11}")
+        for j, p in enumerate(summary["pallets"]):
+            util = p["fall_utilisation"]
+            flag = "  AT RISK" if j in summary["pallets_at_risk"] else ""
+            limit = f"{p['limit_neg_m'] * 1e3:.0f} / {p['limit_pos_m'] * 1e3:.0f}"
+            util_s = "inf" if util is None or not math.isfinite(util) else f"{util:.2f}"
+            lines.append(
+                f"  {j + 1:>3} {int(resp.pallet_level[j]) + 1:>5} {resp.pallet_x[j]:>7.3f} "
+                f"{p['mass_kg']:>9.1f} {p['mu_static']:>5.2f} {p['mu_dynamic']:>5.2f} "
+                f"{p['peak_sliding_m'] * 1e3:>10.2f} {p['residual_m'] * 1e3:>13.2f} "
+                f"{limit:>15} {util_s:>11}{flag}")
+        lines.append("")
+        n_slip = summary["n_slip_events"]
+        lines.append(f"Sliding occurred: {'yes' if summary['sliding_occurred'] else 'no'}"
+                     f" ({n_slip} slip events)")
+        risk = summary["pallets_at_risk"]
+        lines.append("Pallets at risk of falling: "
+                     + (", ".join(f"P{j + 1}" for j in risk) if risk else "none"))
+        lines.extend(_simplified_lines(resp, summary["simplified_check"]))
+    else:
+        lines.append("No pallets on this rack.")
+    if summary.get("outputs"):
+        lines.append("")
+        lines.append("Written: " + ", ".join(summary["outputs"]))
+    return "\n".join(lines)
+
+
+def _simplified_lines(resp: Any, sc: dict[str, Any]) -> list[str]:
+    out = ["", "Simplified check (paper §II/§IV): no sliding if mu_s >= alpha = peak beam "
+               "acceleration / g, alpha from the run with rigidly held pallets"]
+    for lv, alpha in enumerate(sc["alpha_rigid"]):
+        on = [j for j in range(resp.n_pallets) if int(resp.pallet_level[j]) == lv]
+        if not on:
+            continue
+        mus = sorted({float(resp.pallet_mu_static[j]) for j in on})
+        pred = [j for j in on if sc["predicted_sliding"][j]]
+        slid = [j for j in on if sc["sliding"][j]]
+        out.append(f"  level {lv + 1}: alpha = {alpha:.3f}, mu_s = "
+                   f"{', '.join(f'{m:.2f}' for m in mus)}; predicted to slide: "
+                   f"{len(pred)}/{len(on)} pallets, slid: {len(slid)}/{len(on)}")
+    verdict = ("SAFE on this run: every pallet that slid was predicted to slide"
+               if sc["rule_safe"] else
+               "UNSAFE on this run: a pallet slid although mu_s >= alpha")
+    out.append(f"  verdict: {verdict}")
+    return out
+

@@ -1,0 +1,275 @@
+"""Writers for a rack time history (:class:`~seisrack.analysis.rack.RackResponse`).
+
+- ``timehistory.nc``: every time history as a self-describing netCDF file (xarray Dataset, CF-style
+  ``units`` / ``long_name`` attributes, dimensions ``time``, ``level``, ``pallet``, ``upright``).
+  It is written as netCDF3 (classic, 64-bit offsets) through SciPy's writer, so it needs no
+  netCDF4/HDF5 library: xarray + SciPy are enough to write and read it, and every netCDF tool
+  (ncdump, Panoply, MATLAB ``ncread``) opens it. NetCDF3 has no compression and ASCII-only text,
+  which is why the unit strings below are UDUNITS/CF spellings (``m s-2``, ``N m``).
+- ``peaks.csv``: one row per quantity (and per level / pallet / upright), with the unit and the
+  time of the peak.
+- ``summary.json``: the same object as ``seisrack run --json``.
+
+Every file is written to a temporary name in the target folder and then renamed over the final
+name, so an interrupted run never leaves a half-written file in place of a previous result.
+xarray is imported lazily (``pip install 'seisrack[io]'``).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from seisrack import __version__
+from seisrack.analysis.rack import RackResponse
+from seisrack.dynamics.results import EVENT_KINDS
+
+#: the file names seisrack writes into an output folder (nothing else there is touched)
+TIMEHISTORY_FILE = "timehistory.nc"
+PEAKS_FILE = "peaks.csv"
+SUMMARY_FILE = "summary.json"
+DATA_FILES = (TIMEHISTORY_FILE, PEAKS_FILE, SUMMARY_FILE)
+
+
+def _atomic_write(path: Path, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp)`` on a temporary sibling of ``path``, then rename it to ``path``."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+# ---------------------------------------------------------------------------------- netCDF
+def response_dataset(
+    resp: RackResponse, *, model: Any = None, title: str | None = None,
+    summary: Mapping[str, Any] | None = None,
+) -> Any:
+    """The time histories of ``resp`` as an :class:`xarray.Dataset` (SI units, CF attributes).
+
+    model: the :class:`~seisrack.model.frame_model.FrameModel` that was run (optional; adds the
+        level heights ``level_y`` and upright positions ``upright_x``).
+    summary: extra JSON-able metadata stored as the global attribute ``summary_json``.
+    """
+    import xarray as xr
+
+    n_t, n_level = resp.beam_displacement.shape
+    m = resp.n_pallets
+    n_up = resp.upright_moment_base.shape[1]
+
+    def var(dims: tuple[str, ...], data: Any, units: str, long_name: str, **attrs: Any) -> Any:
+        return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name,
+                                                    **attrs})
+
+    coords: dict[str, Any] = {
+        "time": var(("time",), resp.t, "s", "time from the start of the record",
+                    standard_name="time", axis="T"),
+        "level": var(("level",), np.arange(1, n_level + 1, dtype=np.int32), "1",
+                     "beam level number, 1 = lowest"),
+        "upright": var(("upright",), np.arange(1, n_up + 1, dtype=np.int32), "1",
+                       "upright number, 1 = leftmost"),
+    }
+    if model is not None:
+        coords["level_y"] = var(("level",), model.level_y, "m", "height of the beam level")
+        coords["upright_x"] = var(("upright",), model.upright_x, "m", "upright position")
+    data: dict[str, Any] = {
+        "ground_accel": var(("time",), resp.ground_accel, "m s-2",
+                            "horizontal ground acceleration (analysis grid)"),
+        "beam_displacement": var(("time", "level"), resp.beam_displacement, "m",
+                                 "horizontal displacement of the beam level relative to the "
+                                 "ground (mean of its nodes)"),
+        "beam_acceleration": var(("time", "level"), resp.beam_acceleration, "m s-2",
+                                 "absolute horizontal acceleration of the beam level"),
+        "contact_force": var(("time", "level"), resp.contact_force, "N",
+                             "total horizontal contact force of the beams on the pallets of "
+                             "the level"),
+        "total_contact_force": var(("time",), resp.contact_force.sum(axis=1), "N",
+                                   "total horizontal contact force between beams and pallets"),
+        "base_shear": var(("time",), resp.base_shear, "N",
+                          "base shear (support reactions, elastic + stiffness-proportional "
+                          "damping)"),
+        "upright_moment_base": var(("time", "upright"), resp.upright_moment_base, "N m",
+                                   "upright bending moment at the base"),
+        "upright_moment_connection": var(("time", "upright", "level"),
+                                         resp.upright_moment_connection, "N m",
+                                         "upright bending moment at the beam connection "
+                                         "(larger of the segments below / above)"),
+    }
+    if m:
+        hist = resp.history
+        coords.update({
+            "pallet": var(("pallet",), np.arange(1, m + 1, dtype=np.int32), "1",
+                          "pallet number (order of the rack file)"),
+            "pallet_level": var(("pallet",), (resp.pallet_level + 1).astype(np.int32), "1",
+                                "beam level the pallet stands on"),
+            "pallet_x": var(("pallet",), resp.pallet_x, "m", "position of the pallet's node"),
+            "pallet_mass": var(("pallet",), resp.pallet_mass, "kg", "pallet mass"),
+            "mu_static": var(("pallet",), resp.pallet_mu_static, "1",
+                             "static friction coefficient"),
+            "mu_dynamic": var(("pallet",), resp.pallet_mu_dynamic, "1",
+                              "dynamic friction coefficient"),
+            "sliding_limit_neg": var(("pallet",), resp.pallet_limit_neg, "m",
+                                     "free sliding distance towards -x before the pallet falls"),
+            "sliding_limit_pos": var(("pallet",), resp.pallet_limit_pos, "m",
+                                     "free sliding distance towards +x before the pallet falls"),
+        })
+        data.update({
+            "pallet_sliding": var(("time", "pallet"), resp.pallet_sliding, "m",
+                                  "pallet displacement relative to its beam"),
+            "pallet_friction": var(("time", "pallet"), resp.pallet_friction, "N",
+                                   "horizontal force of the beam on the pallet"),
+            "pallet_normal": var(("time", "pallet"), hist.normal, "N",
+                                 "normal force between pallet and beam"),
+            "pallet_stuck": var(("time", "pallet"), hist.stuck.astype(np.int8), "1",
+                                "1 if the pallet sticks to its beam, 0 if it slides",
+                                flag_values=np.array([0, 1], dtype=np.int8),
+                                flag_meanings="sliding stuck"),
+        })
+        if resp.events:
+            coords["event"] = var(("event",), np.arange(1, len(resp.events) + 1,
+                                                        dtype=np.int32), "1", "event number")
+            data["event_time"] = var(("event",), [e.time_s for e in resp.events], "s",
+                                     "time of the contact event")
+            data["event_pallet"] = var(("event",), np.array([e.slider + 1 for e in resp.events],
+                                                            dtype=np.int32), "1",
+                                       "pallet number of the contact event")
+            data["event_kind"] = var(
+                ("event",), np.array([EVENT_KINDS.index(e.kind) for e in resp.events],
+                                     dtype=np.int8), "1", "kind of contact event",
+                flag_values=np.arange(len(EVENT_KINDS), dtype=np.int8),
+                flag_meanings=" ".join(EVENT_KINDS))
+    for key, arr in resp.energy.items():
+        data[f"energy_{key}"] = var(("time",), arr, "J", f"cumulative {key} energy")
+    attrs = {
+        "title": title or f"seisrack rack time history, record {resp.record_name}",
+        "Conventions": "CF-1.8",
+        "source": f"seisrack {__version__} (exact stick-slip, Newmark average acceleration)",
+        "record": resp.record_name,
+        "analysis_dt_s": float(resp.dt),
+        "g_m_s2": float(resp.g),
+        "status": resp.status,
+        "comment": "SI units; motion relative to the ground unless stated (beam_acceleration "
+                   "is absolute)",
+    }
+    if summary is not None:
+        attrs["summary_json"] = json.dumps(_jsonable(summary), allow_nan=False)
+    return xr.Dataset(data, coords=coords, attrs=_ascii_attrs(attrs))
+
+
+def _ascii_attrs(attrs: dict[str, Any]) -> dict[str, Any]:
+    # netCDF3 text is ASCII: replace anything else rather than fail on a title with "μ" or "×"
+    out = {}
+    for k, v in attrs.items():
+        out[k] = v.encode("ascii", "replace").decode() if isinstance(v, str) else v
+    return out
+
+
+def write_timehistory(
+    resp: RackResponse, path: str | Path, *, model: Any = None, title: str | None = None,
+    summary: Mapping[str, Any] | None = None,
+) -> Path:
+    """Write ``timehistory.nc`` (netCDF3 via SciPy; reopen with ``xarray.open_dataset``)."""
+    ds = response_dataset(resp, model=model, title=title, summary=summary)
+    return _atomic_write(Path(path), lambda p: ds.to_netcdf(p, engine="scipy",
+                                                             format="NETCDF3_64BIT"))
+
+
+# ---------------------------------------------------------------------------------- peaks
+def _peak(x: np.ndarray, t: np.ndarray) -> tuple[float, float]:
+    """(max |x|, time of it) over axis 0 of a 1-D series."""
+    k = int(np.argmax(np.abs(x)))
+    return float(abs(x[k])), float(t[k])
+
+
+def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
+    """Rows of the peaks table: quantity, level, pallet, upright, value, unit, time_s, note.
+
+    ``level``, ``pallet`` and ``upright`` are 1-based, empty when not applicable. Values are
+    peaks of the absolute value except for residuals, limits and utilisations.
+    """
+    t = resp.t
+    rows: list[dict[str, Any]] = []
+
+    def add(quantity: str, value: float, unit: str, *, time: float | None = None,
+            level: int | None = None, pallet: int | None = None, upright: int | None = None,
+            note: str = "") -> None:
+        rows.append({"quantity": quantity, "level": level, "pallet": pallet,
+                     "upright": upright, "value": value, "unit": unit, "time_s": time,
+                     "note": note})
+
+    n_level = resp.beam_displacement.shape[1]
+    for lv in range(n_level):
+        v, tt = _peak(resp.beam_displacement[:, lv], t)
+        add("beam_displacement", v, "m", time=tt, level=lv + 1, note="relative to the ground")
+        v, tt = _peak(resp.beam_acceleration[:, lv], t)
+        add("beam_acceleration", v, "m/s2", time=tt, level=lv + 1, note="absolute")
+        v, tt = _peak(resp.contact_force[:, lv], t)
+        add("contact_force", v, "N", time=tt, level=lv + 1, note="beams on pallets, this level")
+    v, tt = _peak(resp.contact_force.sum(axis=1), t)
+    add("total_contact_force", v, "N", time=tt, note="beams on all pallets")
+    v, tt = _peak(resp.base_shear, t)
+    add("base_shear", v, "N", time=tt)
+    for u in range(resp.upright_moment_base.shape[1]):
+        v, tt = _peak(resp.upright_moment_base[:, u], t)
+        add("upright_moment_base", v, "N*m", time=tt, upright=u + 1)
+        for lv in range(n_level):
+            v, tt = _peak(resp.upright_moment_connection[:, u, lv], t)
+            add("upright_moment_connection", v, "N*m", time=tt, level=lv + 1, upright=u + 1)
+    util = resp.fall_utilisation()
+    residual = resp.pallet_residual()
+    for j in range(resp.n_pallets):
+        lv = int(resp.pallet_level[j]) + 1
+        v, tt = _peak(resp.pallet_sliding[:, j], t)
+        add("pallet_sliding", v, "m", time=tt, level=lv, pallet=j + 1,
+            note="relative to its beam")
+        add("pallet_residual", float(residual[j]), "m", time=float(t[-1]), level=lv,
+            pallet=j + 1, note="signed, end of record")
+        v, tt = _peak(resp.pallet_friction[:, j], t)
+        add("pallet_friction", v, "N", time=tt, level=lv, pallet=j + 1)
+        add("pallet_limit_neg", float(resp.pallet_limit_neg[j]), "m", level=lv, pallet=j + 1,
+            note="free distance towards -x")
+        add("pallet_limit_pos", float(resp.pallet_limit_pos[j]), "m", level=lv, pallet=j + 1,
+            note="free distance towards +x")
+        add("pallet_fall_utilisation", float(util[j]), "1", level=lv, pallet=j + 1,
+            note="AT RISK" if util[j] >= 1.0 else "")
+    return rows
+
+
+def write_peaks_csv(resp: RackResponse, path: str | Path) -> Path:
+    """Write the peaks table (:func:`peak_rows`) as CSV with a header row."""
+    rows = peak_rows(resp)
+    fields = ["quantity", "level", "pallet", "upright", "value", "unit", "time_s", "note"]
+
+    def write(p: Path) -> None:
+        with p.open("w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=fields)
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: ("" if r[k] is None else
+                                f"{r[k]:.10g}" if isinstance(r[k], float) else r[k])
+                            for k in fields})
+
+    return _atomic_write(Path(path), write)
+
+
+# ---------------------------------------------------------------------------------- JSON
+def _jsonable(obj: Any) -> Any:
+    from seisrack.cli._common import _to_jsonable
+
+    return _to_jsonable(obj)
+
+
+def write_summary_json(summary: Mapping[str, Any], path: str | Path) -> Path:
+    """Write a summary dict (``RackResponse.summary()`` plus anything else) as JSON."""
+    text = json.dumps(_jsonable(summary), indent=2, allow_nan=False) + "\n"
+    return _atomic_write(Path(path), lambda p: p.write_text(text, encoding="utf-8"))
