@@ -98,7 +98,8 @@ def main() -> None:
     print()
     target = ec8_spectrum(1, "C", 0.3)
     generate_ec8_record(target, seed=100)  # warm-up
-    Tc = np.geomspace(0.05, 4.0, 200)
+    # check grid: denser than, and offset from, the generator's own matching grid
+    Tc = np.geomspace(0.05, 4.0, 331)
     recs, times = [], []
     for seed in range(7):
         t0 = time.perf_counter()
@@ -107,16 +108,24 @@ def main() -> None:
     ratios = np.array([response_spectrum(r.accel, r.dt, Tc, z).psa / target.psa(Tc) for r in recs])
     mean = ratios.mean(axis=0)
     v_end = [abs(np.trapezoid(r.accel, dx=r.dt)) for r in recs]
+    # final displacement of the piecewise-linear record, exactly (as the baseline correction)
+    d_end = []
+    for r in recs:
+        v = np.concatenate([[0.0], np.cumsum(0.5 * r.dt * (r.accel[1:] + r.accel[:-1]))])
+        d_end.append(abs(np.sum(r.dt * v[:-1] + r.dt**2 * (r.accel[:-1] / 3 + r.accel[1:] / 6))))
     print(f"generation ({target.name}, ag = 0.3 g, 15 s, dt = 0.01 s, seeds 0-6)")
     print(f"  time per record [s]: min {min(times):.3f}  mean {np.mean(times):.3f}  "
-          f"max {max(times):.3f}")
-    print(f"  each record / target over 0.05-4 s: {ratios.min():.3f} .. {ratios.max():.3f}; "
-          f"share of (record, period) within ±10 %: {100 * np.mean(abs(ratios - 1) <= .1):.1f} %")
-    print("  worst record-wise range: "
-          + ", ".join(f"{r.min():.2f}-{r.max():.2f}" for r in ratios))
+          f"max {max(times):.3f}  (after warm-up; the time-domain stage dominates)")
+    print(f"  each record / target over 0.05-4 s ({Tc.size} periods): {ratios.min():.3f} .. "
+          f"{ratios.max():.3f}; records within ±10 % everywhere: "
+          f"{np.sum(np.all(abs(ratios - 1) <= .1, axis=1))}/{len(recs)}")
+    print("  record-wise range: "
+          + ", ".join(f"{r.min():.3f}-{r.max():.3f}" for r in ratios))
+    print("  iterations: " + ", ".join(str(r.meta["iterations"]) for r in recs))
     print(f"  suite mean / target: {mean.min():.3f} .. {mean.max():.3f}")
     print(f"  mean PGA / (ag S): {np.mean([r.pga for r in recs]) / target.pga:.3f}")
-    print(f"  max |final velocity| [m/s]: {max(v_end):.2e}")
+    print(f"  max |final velocity| [m/s]: {max(v_end):.2e}; max |final displacement| [m]: "
+          f"{max(d_end):.2e}")
     print("  peers: eqsig has no spectrum-compatible generator; REQPY not installed "
           "(issue #4 quotes 7-8 s per record)")
 

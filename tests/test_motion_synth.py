@@ -1,9 +1,11 @@
 """Spectrum-compatible artificial accelerograms: EN 1998-1 §3.2.3.1.2 targets.
 
 Source of the requirements: EN 1998-1:2004 §3.2.3.1.2(4) (mean PGA ≥ a_g·S, mean spectrum ≥ 90 %
-of the target, stationary part ≥ 10 s) and issue #4 (suite mean within [0.95, 1.10] of the target
-over 0.05–4 s; final velocity and displacement zero). Spectra are computed with the exact
-response spectrum validated in test_motion_spectra.py.
+of the target, stationary part ≥ 10 s) and issue #4 (each record's 5 %-damped spectrum within
+±10 % of the target over 0.05–4 s; suite mean within [0.95, 1.10]; final velocity and
+displacement zero). Spectra are computed with the exact response spectrum validated in
+test_motion_spectra.py, on a check grid (240 log-spaced periods) denser than, and offset from,
+the generator's own matching grid, so that dips between matched periods are seen.
 """
 
 import numpy as np
@@ -19,11 +21,12 @@ from seisrack.motion import (
     response_spectrum,
 )
 
-T_CHECK = np.geomspace(0.05, 4.0, 120)
+T_CHECK = np.geomspace(0.05, 4.0, 240)
 
 
 @pytest.mark.parametrize(
-    ("kind", "ground", "ag", "seed"), [(1, "C", 0.3, 0), (2, "B", 0.2, 5), (1, "D", 0.15, 11)]
+    ("kind", "ground", "ag", "seed"),
+    [(1, "C", 0.3, 0), (2, "B", 0.2, 5), (1, "D", 0.15, 11), (2, "E", 0.25, 20)],
 )
 def test_suite_of_seven_meets_targets(kind: int, ground: str, ag: float, seed: int) -> None:
     target = ec8_spectrum(kind, ground, ag)
@@ -34,9 +37,8 @@ def test_suite_of_seven_meets_targets(kind: int, ground: str, ag: float, seed: i
     mean = ratios.mean(axis=0)
     assert 0.95 <= mean.min() and mean.max() <= 1.10, (mean.min(), mean.max())
     assert np.mean([r.pga for r in recs]) >= target.pga
-    # each record: broadly compatible (the ±10 % per-record goal is not met everywhere, see notes)
-    assert 0.75 <= ratios.min() and ratios.max() <= 1.25
-    assert np.mean(np.abs(ratios - 1) <= 0.10) >= 0.9
+    # each record, at every check period: within ±10 % of the target
+    assert 0.90 <= ratios.min() and ratios.max() <= 1.10, (ratios.min(), ratios.max())
     for r in recs:  # baseline correction inside the loop: at rest at the end
         v = np.concatenate([[0.0], np.cumsum(0.5 * r.dt * (r.accel[1:] + r.accel[:-1]))])
         d_end = np.sum(r.dt * v[:-1] + r.dt**2 * (r.accel[:-1] / 3 + r.accel[1:] / 6))
@@ -44,6 +46,7 @@ def test_suite_of_seven_meets_targets(kind: int, ground: str, ag: float, seed: i
         assert abs(v[-1]) < 1e-9 * peak_v
         assert abs(d_end) < 1e-9 * peak_v * r.duration
         assert r.accel[0] == 0.0 and abs(r.accel[-1]) < 1e-9 * r.pga
+        assert r.meta["stationary_duration_s"] >= 10.0
     rep = check_ec8_suite(recs, target, period=0.5)
     assert rep.passed, rep.text()
 

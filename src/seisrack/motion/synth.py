@@ -1,45 +1,77 @@
 """Spectrum-compatible artificial accelerograms (EN 1998-1 §3.2.3.1.2), reproducible from a seed.
 
-Method (the classical stationary-noise approach of SIMQKE, Gasparini & Vanmarcke 1976, with the
-baseline correction moved inside the loop):
+Method: a stationary-noise seed corrected in the frequency domain (SIMQKE, Gasparini & Vanmarcke
+1976), then in the time domain with wavelets (the approach of Lilhanand & Tseng 1988, as improved
+by Al Atik & Abrahamson 2010, written here from the papers' ideas), with the baseline correction
+inside both loops:
 
 1. a band-limited stochastic seed: Gaussian white noise from ``numpy.random.default_rng(seed)``,
    Fourier amplitudes shaped by the target spectrum and cut outside [f_min, f_max];
 2. the stationary signal is multiplied by an envelope with a stationary part (≥ 10 s by default);
-3. iterative spectral correction: the Fourier amplitudes of the current record (zero-padded to
-   ≥ 4× its length for a fine frequency grid) are multiplied by the ratio target / computed
-   response spectrum (5 % by default, exact Nigam–Jennings from
-   :func:`seisrack.motion.spectra.response_spectrum`), interpolated in log-period; the iterate
-   with the smallest misfit is kept;
-4. inside every iteration, after the envelope, a baseline correction
-   ``a ← a - e(t) (c0 + c1 t / t_end)`` (e = envelope) with c0, c1 solving the two linear
-   conditions v(t_end) = 0 and d(t_end) = 0 *exactly* for piecewise-linear acceleration; the
-   spectrum is computed on the corrected signal, so the record returned both matches the target
-   and ends at rest with zero velocity and displacement.
+3. frequency-domain correction (a few iterations): the Fourier amplitudes of the current record
+   (zero-padded to ≥ 4× its length) are multiplied by target / computed response spectrum (exact
+   Nigam–Jennings from :func:`seisrack.motion.spectra.response_spectrum`), the ratio being
+   evaluated on a *dense* grid of periods (~2.6 % apart, finer than the ~10 % half-power
+   bandwidth of a 5 %-damped oscillator) and interpolated in log-period;
+4. time-domain correction: for the dense periods where the misfit is locally extreme (plus every
+   4th period), the time and value of the peak response are found; a wavelet is placed at each
+   peak (the oscillator's own impulse response reversed in time, so that it acts on that peak
+   most, under a Gaussian window about one period long), and the wavelet amplitudes solve, in
+   the least-squares sense with a small Tikhonov term, the *linear* equations "response at the
+   peak times = aim". The response of every constrained oscillator to every wavelet is exact
+   (discrete convolution with the oscillator's kernel for piecewise-linear input). The secondary
+   peaks of each response (≥ 75 % of the largest, in other half-cycles) enter as equations too:
+   held where they are or pushed under the aim (without them the peak jumps to another cycle and
+   the iteration oscillates), or raised with the primary peak when both are nearly equal and
+   below the aim (where two peaks cross over in period, the spectrum otherwise keeps a V-shaped
+   dip between matched periods);
+5. inside every iteration a baseline correction ``a ← a - e(t) (c0 + c1 t / t_end)`` (e =
+   envelope) with c0, c1 solving v(t_end) = 0 and d(t_end) = 0 *exactly* for piecewise-linear
+   acceleration; in step 4 the wavelets themselves are baseline-corrected before the solve, so
+   the solve sees exactly what is added. The record returned therefore both matches the target
+   and ends at rest with zero velocity and displacement. The iterate with the smallest misfit
+   is kept.
+
+References: Gasparini D. A., Vanmarcke E. H. (1976), SIMQKE, MIT report R76-4; Lilhanand K.,
+Tseng W. S. (1988), Proc. 9th WCEE, vol. II, 819–824; Al Atik L., Abrahamson N. (2010),
+Earthquake Spectra 26(3), 601–617.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+from functools import lru_cache
 
 import numpy as np
+import scipy.fft
 
 from seisrack.errors import InputError
 from seisrack.motion.ec8 import DesignSpectrum, ec8_spectrum
 from seisrack.motion.records import Record
-from seisrack.motion.spectra import response_spectrum
+from seisrack.motion.spectra import response_spectrum, step_coefficients
 
 log = logging.getLogger(__name__)
 
-# exponent of the correction ratio per iteration
-_GAIN = 1.0
-# control periods, log-spaced over period_range
-_N_CONTROL = 100
-# the iteration aims 3 % above the target: between control periods a single record's spectrum dips
-# further than it peaks, so this centres the suite mean on the target (measured: mean of 7 in
-# [0.97, 1.07] over 0.05-4 s)
-_BIAS = 1.03
+# periods of the dense matching grid over period_range (log-spaced, ~2.6 % apart by default)
+_N_DENSE = 200
+# frequency-domain iterations before the time-domain (wavelet) stage
+_N_FREQ = 6
+# the iteration aims 1 % above the target: a record's spectrum dips between matched periods a
+# little further than it peaks
+_BIAS = 1.01
+# wavelet stage: every _STRIDE-th dense period is always constrained, besides the local extrema
+# of the misfit; up to _N_PEAKS peaks per response; a secondary peak is constrained when it is
+# ≥ _SECONDARY × the largest, raised with the primary when ≥ _RAISE × it and below the aim, else
+# pushed under _HOLD × the aim when it would exceed it; primary
+# equations weigh _W_PRIMARY; Tikhonov term _RIDGE on the normalised (unit-diagonal) system
+_STRIDE = 4
+_N_PEAKS = 3
+_SECONDARY = 0.75
+_HOLD = 0.97
+_RAISE = 0.9
+_W_PRIMARY = 3.0
+_RIDGE = 1e-4
 ENVELOPES = ("trapezoidal", "jennings", "saragoni-hart")
 
 
@@ -112,6 +144,118 @@ def _baseline(a: np.ndarray, basis: np.ndarray, wv: np.ndarray, wd: np.ndarray) 
     return a - c @ basis
 
 
+@lru_cache(maxsize=8)
+def _sdof_kernels(
+    lo: float, hi: float, n_per: int, zeta: float, dt: float, length: int, nfft: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Discrete response kernels G (n_per, length), their rFFT and the wavelet shapes.
+
+    Returns ``G``, ``rfft(G, nfft)`` (n_per, nfft // 2 + 1) and ``Gw`` (n_per, length): G under
+    the wavelet window (see :func:`_wavelet_step`).
+
+    ``u_i[m] = Σ_k G_i[m - k] p_k`` is the exact relative displacement at sample m of oscillator
+    i (periods ``geomspace(lo, hi, n_per)``) under the piecewise-linear load p (p_0 = 0), from
+    rest: the exact recurrence of :func:`~seisrack.motion.spectra.step_coefficients` is linear in
+    p, a unit p_k enters at the step ending at k (b11, b21) and at the next one (b10, b20), and
+    the state then decays freely (Chopra §2.2 closed form).
+    """
+    w = 2.0 * np.pi / np.geomspace(lo, hi, n_per)
+    wd = w * math.sqrt(1.0 - zeta * zeta)
+    a11, a12, a21, a22, b10, b11, b20, b21 = step_coefficients(w, zeta, dt)
+    u1 = a11 * b11 + a12 * b21 + b10
+    v1 = a21 * b11 + a22 * b21 + b20
+    tau = np.arange(length - 1) * dt
+    G = np.empty((w.size, length))
+    G[:, 0] = b11
+    G[:, 1:] = np.exp(-zeta * w[:, None] * tau) * (
+        u1[:, None] * np.cos(wd[:, None] * tau)
+        + ((v1 + zeta * w * u1) / wd)[:, None] * np.sin(wd[:, None] * tau)
+    )
+    Gf = scipy.fft.rfft(G, nfft)
+    # wavelet j = oscillator j's kernel reversed about its peak time (a matched filter) under a
+    # Gaussian window one period wide, centred one period before the peak
+    T = 2.0 * np.pi / w[:, None]
+    Gw = G * np.exp(-(((np.arange(length) * dt - T) / T) ** 2))
+    for arr in (G, Gf, Gw):
+        arr.flags.writeable = False
+    return G, Gf, Gw
+
+
+def _wavelet_step(
+    a: np.ndarray, ratio: np.ndarray, periods: np.ndarray,
+    kernels: tuple[np.ndarray, np.ndarray, np.ndarray], nfft: int, dt: float,
+    taper: np.ndarray, basis: np.ndarray, project: np.ndarray,
+) -> np.ndarray:
+    """One time-domain correction of ``a`` (n,) [m/s²]; ratio (n_T,) = computed / aimed spectrum.
+
+    See step 4 of the module docstring. Returns the corrected, baseline-corrected record.
+    """
+    G, Gf, Gw = kernels
+    n = a.size
+    x = ratio - 1.0
+    sel = np.zeros(x.size, dtype=bool)
+    sel[1:-1] = ((x[1:-1] >= x[:-2]) & (x[1:-1] >= x[2:])) | (
+        (x[1:-1] <= x[:-2]) & (x[1:-1] <= x[2:]))
+    sel[::_STRIDE] = True
+    sel[-1] = True
+    idx_T = np.flatnonzero(sel)
+    T = periods[idx_T]
+    r = ratio[idx_T]
+    # response histories up to one period after the record (as response_spectrum's default)
+    m_end = n - 1 + np.ceil(T / dt).astype(np.int64)
+    u = scipy.fft.irfft(scipy.fft.rfft(-a, nfft)[None, :] * Gf[idx_T], nfft)
+    # primary and secondary peaks: each further peak outside ±0.3 T of those already found
+    au = np.abs(u[:, : m_end.max() + 1])
+    for row, me in enumerate(m_end):
+        au[row, me + 1:] = 0.0
+    half = np.ceil(0.3 * T / dt).astype(np.int64)
+    peaks = []
+    for _ in range(_N_PEAKS):
+        mq = np.argmax(au, axis=1)
+        peaks.append(mq)
+        for row, (mr, h) in enumerate(zip(mq, half, strict=True)):
+            au[row, max(mr - h, 0): mr + h + 1] = 0.0
+    rows = np.arange(T.size)
+
+    def kernel_rows(K: np.ndarray, i_osc: np.ndarray, m: np.ndarray) -> np.ndarray:
+        # out[r, k] = K_i[m_r - k] (zero for k > m_r): the kernel reversed about m_r; K is
+        # long enough (the record plus one longest period) for every m_r
+        out = np.zeros((i_osc.size, n))
+        for row, (i, mr) in enumerate(zip(idx_T[i_osc], m, strict=True)):
+            j = min(int(mr), n - 1)
+            out[row, : j + 1] = K[i, mr - j : mr + 1][::-1]
+        return out
+
+    m1 = peaks[0]
+    u1 = u[rows, m1]
+    W = kernel_rows(G, rows, m1)
+    F = kernel_rows(Gw, rows, m1) * taper
+    F /= np.abs(F).max(axis=1, keepdims=True)
+    F -= (F @ project.T) @ basis  # baseline-corrected wavelets
+    C = -(W @ F.T) / u1[:, None]  # relative change of peak i per unit amplitude of wavelet j
+    d = np.diag(C).copy()
+    C /= d[None, :]
+    F /= d[:, None]
+    eqs = [_W_PRIMARY * C]
+    rhs = [_W_PRIMARY * (1.0 / r - 1.0)]
+    for mq in peaks[1:]:
+        uq = u[rows, mq]
+        lvl = np.abs(uq) / np.abs(u1)
+        keep = lvl >= _SECONDARY
+        if keep.any():
+            Wq = kernel_rows(G, rows[keep], mq[keep])
+            eqs.append(-(Wq @ F.T) / uq[keep][:, None])
+            rq, lq = r[keep], lvl[keep]
+            # below the aim, a near-equal peak is raised with the primary: the spectrum then
+            # has no V-shaped dip where the two peaks cross over in period; otherwise a
+            # secondary peak is held, or pushed under the aim
+            rhs.append(np.where((rq < 1.0) & (lq >= _RAISE), 1.0 / rq - 1.0,
+                                np.minimum(0.0, _HOLD / (rq * lq) - 1.0)))
+    A = np.vstack(eqs)
+    b = np.linalg.solve(A.T @ A + _RIDGE * np.eye(T.size), A.T @ np.concatenate(rhs))
+    return a + b @ F
+
+
 def generate_ec8_record(
     spectrum: DesignSpectrum | None = None,
     *,
@@ -126,8 +270,8 @@ def generate_ec8_record(
     envelope_kind: str = "trapezoidal",
     stationary: float | None = None,
     period_range: tuple[float, float] = (0.03, 5.0),
-    tol: float = 0.04,
-    max_iter: int = 25,
+    tol: float = 0.06,
+    max_iter: int = 22,
     name: str | None = None,
 ) -> Record:
     """One spectrum-compatible artificial accelerogram.
@@ -141,12 +285,14 @@ def generate_ec8_record(
         envelope_kind: ``"trapezoidal"``, ``"jennings"`` or ``"saragoni-hart"`` (see
             :func:`envelope`); stationary: [s] plateau length (default ≥ 10 s).
         period_range: [s] periods where the spectrum is matched (covers EC8's 0.05–4 s check).
-        tol: stop when every control period is within ±tol of the target.
-        max_iter: maximum number of correction iterations.
+        tol: stop when the spectrum is within ±tol of the aim at every dense-grid period in
+            [1.5·Tmin, 0.88·Tmax] (by default 0.045–4.4 s, covering EC8's 0.05–4 s check).
+        max_iter: maximum number of correction iterations (the first 6 in the frequency
+            domain, the others with wavelets in the time domain).
 
     Returns:
         :class:`Record` with accel (n,) [m/s²], ``meta`` holding ``seed``, ``iterations``,
-        ``max_misfit`` (largest |computed/aimed - 1| over the control periods, the aim being 3 %
+        ``max_misfit`` (largest |computed/aimed - 1| over that band, the aim being 1 %
         above the target), ``stationary_duration_s``, ``target``.
     """
     if spectrum is None:
@@ -166,12 +312,17 @@ def generate_ec8_record(
     n = env.size
     t = np.arange(n) * dt
     zeta = float(spectrum.damping)
-    periods = np.geomspace(lo, hi, _N_CONTROL)
+    periods = np.geomspace(lo, hi, _N_DENSE)
     target = spectrum.psa(periods) * _BIAS
+    # the misfit (tol, best iterate) is measured inside the band's edges, which are less
+    # controllable: 3 samples per period at the short end, few cycles at the long end
+    inner = (periods >= 1.5 * lo) & (periods <= 0.88 * hi)
+    if not inner.any():  # a narrow period_range: measure over all of it
+        inner[:] = True
 
     # 1. band-limited seed shaped by the target (f_min = 1/(2 Tmax), f_max = min(1/Tmin·1.5, Nyq))
     rng = np.random.default_rng(int(seed))
-    # zero padding: a finer frequency grid lets the correction act between long control periods
+    # zero padding: a finer frequency grid lets the correction act between long periods
     nfft = 1 << int(math.ceil(math.log2(4 * n)))
     freqs = np.fft.rfftfreq(nfft, dt)
     fmin, fmax = 0.5 / hi, min(1.5 / lo, 0.5 / dt)
@@ -188,32 +339,46 @@ def generate_ec8_record(
     X *= ratio_at_f(target)
     basis = np.vstack([env, env * t / t[-1]])
     wv, wd = _end_state_weights(n, dt)
-
-    def realise(spec: np.ndarray) -> np.ndarray:
-        a = np.fft.irfft(spec, nfft)[:n] * env
-        return _baseline(a, basis, wv, wd)
-
-    a = realise(X)
+    # c = project @ a gives the baseline coefficients of a (see _baseline)
+    project = np.linalg.solve(
+        np.array([[wv @ basis[0], wv @ basis[1]], [wd @ basis[0], wd @ basis[1]]]),
+        np.vstack([wv, wd]),
+    )
+    a = _baseline(np.fft.irfft(X, nfft)[:n] * env, basis, wv, wd)
     # keeps the start and end at zero after each correction (the envelope's own ramps)
     taper = np.minimum(1.0, env / 0.05)
     # scale once to the target level before the shape iteration
     sa = response_spectrum(a, dt, periods, zeta).psa
-    X *= float(np.exp(np.mean(np.log(target / sa))))
-    a = realise(X)
+    a *= float(np.exp(np.mean(np.log(target / sa))))
+    # time-domain stage: kernels long enough for the record plus one longest period, and an FFT
+    # long enough for that linear convolution not to wrap
+    m_max = n + int(math.ceil(hi / dt))
+    nconv = scipy.fft.next_fast_len(m_max + n, real=True)
+    kernels = None
     best, best_mis = a, np.inf
     it = 0
     while it < max_iter:
         it += 1
-        sa = response_spectrum(a, dt, periods, zeta).psa
-        mis = float(np.max(np.abs(sa / target - 1.0)))
+        ratio = response_spectrum(a, dt, periods, zeta).psa / target
+        mis = float(np.max(np.abs(ratio[inner] - 1.0)))
         if mis < best_mis:
             best, best_mis = a, mis
         if mis <= tol:
             break
-        # correct the current (enveloped, baseline-corrected) record itself, then re-correct
-        # its baseline: the spectrum of the next iterate is that of the corrected signal
-        spec = np.fft.rfft(a, nfft) * ratio_at_f((target / sa) ** _GAIN)
-        a = _baseline(np.fft.irfft(spec, nfft)[:n] * taper, basis, wv, wd)
+        if it <= _N_FREQ:
+            # correct the current (enveloped, baseline-corrected) record itself, then re-correct
+            # its baseline: the spectrum of the next iterate is that of the corrected signal
+            spec = np.fft.rfft(a, nfft) * ratio_at_f(1.0 / ratio)
+            a = _baseline(np.fft.irfft(spec, nfft)[:n] * taper, basis, wv, wd)
+        else:
+            if kernels is None:
+                kernels = _sdof_kernels(lo, hi, _N_DENSE, zeta, float(dt), nconv - n + 1, nconv)
+            a = _wavelet_step(a, ratio, periods, kernels, nconv, dt, taper, basis, project)
+    else:
+        ratio = response_spectrum(a, dt, periods, zeta).psa / target
+        mis = float(np.max(np.abs(ratio[inner] - 1.0)))
+        if mis < best_mis:
+            best, best_mis = a, mis
     if best_mis > tol:
         log.info("seed %s: spectral misfit %.3f after %d iterations", seed, best_mis, it)
     meta = {
