@@ -209,7 +209,10 @@ def _end_of_sliding(theta0: float, d: int, rho_d: float, theta_max: float) -> fl
     lo = theta0
     while True:
         for c in sorted((b + 2 * math.pi * k, math.pi - b + 2 * math.pi * k)):
-            if c <= theta0 + 1e-15:
+            # a sliding phase that starts at sin(theta0) = mu_s/alpha = mu_d/alpha begins ON a
+            # critical angle; skip it with a tolerance relative to theta (an absolute 1e-15 fails
+            # once theta0 ~ 30 rad, ending the phase at its start: a spurious stick)
+            if c <= theta0 + 1e-12 * max(1.0, abs(theta0)):
                 continue
             if lo > theta_max + 2.0 * math.pi:
                 return None
