@@ -139,7 +139,10 @@ def run_validation_section(out_dir: Path, *, quick: bool = False) -> Section:
     sec.checks = [
         Check("§III", "engine = reference (peaks)", worst_u < TOL_PEAK and worst_s < TOL_PEAK,
               f"largest relative difference over {n_cases} cases: {100 * worst_u:.3f} % on peak "
-              f"displacement, {100 * worst_s:.3f} % on peak sliding",
+              f"displacement, {100 * worst_s:.3f} % on peak sliding"
+              + (" (issue #3 asks 0.5 %: missed on sliding by the grazing slip of example 2,"
+                 " mu = 0.5, which converges at order 2 and is within 0.5 % at dt = 0.5 ms)"
+                 if worst_s > 0.005 else ""),
               f"< {100 * TOL_PEAK:g} % (engine dt = {1e3 * ENGINE_DT:g} ms)"),
         Check("§III", "engine = reference (sliding phases)", ph_ok,
               "same number of sliding phases in every case" if ph_ok else
