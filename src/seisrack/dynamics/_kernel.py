@@ -506,23 +506,28 @@ def run_kernel(
                     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
                 )
                 cache_ok = False
-            # event detection at the end of the trial
-            _mv(P, qd, vn0)
+            # event detection at the end of the trial (end values only; the start values are
+            # needed only when an event must be located)
+            any_ev = False
             for j in range(m):
-                s0[j] = wd[j] - vn0[j]
-                N_lo[j] = N[step, j] + tau * (N[step + 1, j] - N[step, j])
+                n1 = N[step + 1, j]
                 if stuck[j]:
-                    tolF[j] = 1e-11 * mus[j] * max(N_lo[j], N[step + 1, j]) + 1e-300
+                    tolF[j] = 1e-11 * mus[j] * max(N[step, j], n1) + 1e-300
+                    e_hi[j] = abs(lam1[j]) - mus[j] * n1
                 else:
                     # a reversal/stick must be a real sign change of the relative velocity, not
                     # round-off around zero just after a slip onset with mu_d = mu_s
-                    tolF[j] = 1e-9 * (abs(wd[j]) + abs(vn0[j]) + mud[j] * N_lo[j] / mass[j] * dt)
-            _event_values(stuck, sig, lam, N_lo, s0, mus, e_lo)
-            _event_values(stuck, sig, lam1, N[step + 1], s1, mus, e_hi)
-            any_ev = False
-            for j in range(m):
+                    vscale = abs(wd1[j]) + abs(wd1[j] - s1[j]) + mud[j] * n1 / mass[j] * dt
+                    tolF[j] = 1e-9 * vscale
+                    e_hi[j] = -sig[j] * s1[j]
                 if e_hi[j] > tolF[j]:
                     any_ev = True
+            if any_ev:
+                _mv(P, qd, vn0)
+                for j in range(m):
+                    s0[j] = wd[j] - vn0[j]
+                    N_lo[j] = N[step, j] + tau * (N[step + 1, j] - N[step, j])
+                _event_values(stuck, sig, lam, N_lo, s0, mus, e_lo)
             theta_hi = 1.0  # fractions of the remaining sub-step
             if any_ev:
                 # regula falsi on the earliest violated event function, with a bisection
