@@ -61,3 +61,26 @@ def test_errors_exit_nonzero_without_traceback(
     with pytest.raises(SystemExit) as exc:
         main(["motion", "generate", "--ag", "0.3", "--out", str(tmp_path)])  # no --seed
     assert exc.value.code == 2
+
+
+def test_generate_never_overwrites_without_force(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Nothing the user already has is lost: existing record files are kept unless --force."""
+    mine = tmp_path / "mine.csv"
+    mine.write_text("precious\n")
+    base = ["motion", "generate", "--type", "1", "--ground", "C", "--ag", "0.3",
+            "--duration", "12", "--seed", "3"]
+    assert main([*base, "--out", str(mine)]) == 2
+    assert mine.read_text() == "precious\n"
+    assert "--force" in capsys.readouterr().err
+    suite = tmp_path / "suite"
+    assert main([*base, "--count", "2", "--out", str(suite)]) == 0
+    written = sorted(p.name for p in suite.iterdir())
+    before = {p: p.read_bytes() for p in suite.iterdir()}
+    # the second call would write seed 4 again (3 + 1): refused, nothing touched
+    assert main([*base[:-1], "4", "--count", "2", "--out", str(suite)]) == 2
+    assert {p: p.read_bytes() for p in suite.iterdir()} == before
+    assert written == ["EC8_type_1_ground_C_seed3.csv", "EC8_type_1_ground_C_seed4.csv"]
+    assert main([*base, "--out", str(mine), "--force"]) == 0
+    assert read_record(mine).accel.size > 100

@@ -27,6 +27,8 @@ def register(subparsers: Any) -> None:
     g.add_argument("--envelope", choices=["trapezoidal", "jennings", "saragoni-hart"],
                    default="trapezoidal")
     g.add_argument("--out", required=True, help="CSV file (one record) or folder (several)")
+    g.add_argument("--force", action="store_true",
+                   help="overwrite existing record files (refused by default)")
     g.add_argument("--plot", help="PNG of the first record and its spectrum vs the target")
     g.add_argument("--json", action="store_true")
     g.set_defaults(func=_generate)
@@ -61,12 +63,29 @@ def _generate(args: argparse.Namespace) -> int:
 
     if args.count < 1:
         raise InputError("--count", args.count, "an integer >= 1")
+    out = Path(args.out)
+    single = args.count == 1 and out.suffix.lower() == ".csv"
+    if single:
+        planned = [out]
+    else:
+        planned = [
+            out / f"EC8_type_{args.type}_ground_{args.ground}_seed{args.seed + i}.csv"
+            for i in range(args.count)
+        ]
+    existing = [p for p in planned if p.exists()]
+    if existing and not args.force:
+        raise InputError(
+            "--out", str(existing[0]),
+            "a path that does not exist yet (or pass --force to overwrite)",
+            hint=f"{len(existing)} of the {len(planned)} record file(s) already exist",
+        )
+    if not single and out.exists() and not out.is_dir():
+        raise InputError("--out", str(out), "a folder (several records) or a .csv file path")
     target = ec8_spectrum(args.type, args.ground, args.ag, damping=args.damping,
                           importance=args.importance)
     recs = generate_ec8_suite(args.count, seed=args.seed, spectrum=target,
                               duration=args.duration, dt=args.dt, envelope_kind=args.envelope)
-    out = Path(args.out)
-    if args.count == 1 and out.suffix.lower() == ".csv":
+    if single:
         out.parent.mkdir(parents=True, exist_ok=True)
         paths = [write_record_csv(recs[0], out)]
     else:
