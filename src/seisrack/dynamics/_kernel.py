@@ -15,8 +15,8 @@ Formulation (see ``docs/theory/stick_slip_engine.md``):
   fixed: stuck sliders satisfy zero relative velocity at the end of the step, sliding sliders carry
   ``lam = -mu_d N sign(s)``. The stuck forces solve a small SPD system ``A_SS lam_S = -b_S``.
 * Transitions are located *inside* the step: an event function per slider (``|lam| - mu_s N`` for
-  stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by regula falsi (with a
-  bisection safeguard) on the sub-step length, the step is split there, and the new contact
+  stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by Illinois regula falsi
+  (bisection safeguard) on the sub-step length, the step is split there, and the new contact
   state is decided at the acceleration level (active set on ``B = diag(1/m) + P P^T``).
 """
 
@@ -530,12 +530,14 @@ def run_kernel(
                 _event_values(stuck, sig, lam, N_lo, s0, mus, e_lo)
             theta_hi = 1.0  # fractions of the remaining sub-step
             if any_ev:
-                # regula falsi on the earliest violated event function, with a bisection
-                # step whenever the same end of the bracket is kept twice in a row. ``e_lo`` and
-                # ``e_hi`` always hold the true event values at the bracket ends.
+                # Illinois regula falsi on the earliest violated event function (bisection if it
+                # stalls). ``e_lo`` and ``e_hi`` always hold the true event values at the bracket
+                # ends; the Illinois weights only enter the interpolation.
                 theta_lo = 0.0
                 streak = 0
                 side = 0
+                sc_lo = 1.0  # Illinois weights (interpolation only, never the violation test)
+                sc_hi = 1.0
                 # the hi state is the current trial
                 qb[:] = q1
                 qdb[:] = qd1
@@ -551,8 +553,10 @@ def run_kernel(
                     jmin = -1
                     for j in range(m):
                         if e_hi[j] > tolF[j]:
-                            elo = min(e_lo[j], 0.0)
-                            den = e_hi[j] - elo
+                            # root of e - tolF (the violation threshold), not of e: a slider that
+                            # just slipped starts at e = 0 and creeps up quadratically
+                            elo = min(e_lo[j] - tolF[j], 0.0) * sc_lo
+                            den = (e_hi[j] - tolF[j]) * sc_hi - elo
                             frac = -elo / den if den > 0.0 else 0.0
                             tj = theta_lo + frac * (theta_hi - theta_lo)
                             if tj < th or jmin < 0:
@@ -568,7 +572,7 @@ def run_kernel(
                     span = theta_hi - theta_lo
                     if conv or span * hrem <= 1e-12 * dt:
                         break
-                    if streak >= 2:
+                    if streak >= 6:  # safeguard: Illinois stalled, bisect
                         th = theta_lo + 0.5 * span
                         streak = 0
                     # keep strictly inside the bracket
@@ -607,11 +611,17 @@ def run_kernel(
                         lamb[:] = lam1
                         sb[:] = s1
                         streak = streak + 1 if side == 1 else 1
+                        if side == 1:
+                            sc_lo *= 0.5  # lo kept twice: halve its weight
+                        sc_hi = 1.0
                         side = 1
                     else:
                         theta_lo = th
                         e_lo[:] = e_try
                         streak = streak + 1 if side == -1 else 1
+                        if side == -1:
+                            sc_hi *= 0.5  # hi kept twice: halve its weight
+                        sc_lo = 1.0
                         side = -1
                 # accept the (tiny-violation) hi state
                 q1[:] = qb
