@@ -121,3 +121,19 @@ def test_zero_period_is_pga_and_bad_input() -> None:
         response_spectrum(np.array([0.0, np.nan, 1.0]), dt, [1.0])
     with pytest.raises(InputError):
         response_spectrum(a, dt, [1.0], damping=1.0)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_free_vibration_closed_form_equals_stepping(backend: str) -> None:
+    # the free vibration after the record is taken in closed form from the final state; it
+    # must equal stepping through explicit trailing zeros (one period of the longest oscillator)
+    a, dt = _record(4.0, 0.01)
+    T = np.array([0.04, 0.3, 1.0, 2.5, 6.0])
+    closed = response_spectrum(a, dt, T, 0.05, backend=backend).sd
+    padded = np.concatenate([a, np.zeros(int(np.ceil(T.max() / dt)) + 2)])
+    stepped = response_spectrum(padded, dt, T, 0.05, backend=backend, free_vibration=False).sd
+    np.testing.assert_allclose(closed, stepped, rtol=1e-6)
+    # and for an undamped oscillator, whose free vibration does not decay
+    a0 = response_spectrum(a, dt, [2.5], 0.0, backend=backend).sd
+    s0 = response_spectrum(padded, dt, [2.5], 0.0, backend=backend, free_vibration=False).sd
+    np.testing.assert_allclose(a0, s0, rtol=1e-6)

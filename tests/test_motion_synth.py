@@ -19,7 +19,9 @@ from seisrack.motion import (
     generate_ec8_record,
     generate_ec8_suite,
     response_spectrum,
+    synth,
 )
+from seisrack.motion.synth import OPS_NUMBA
 
 T_CHECK = np.geomspace(0.05, 4.0, 240)
 
@@ -88,3 +90,27 @@ def test_bad_generation_input() -> None:
         generate_ec8_record(duration=1.0)
     with pytest.raises(InputError):
         generate_ec8_suite(0)
+
+
+@pytest.mark.skipif(OPS_NUMBA is None, reason="numba not installed")
+def test_wavelet_step_numba_numpy_parity() -> None:
+    # one time-domain correction with the numba kernels and with their numpy twins
+    dt, lo, hi, zeta = 0.01, 0.03, 5.0, 0.05
+    env, _ = envelope("trapezoidal", 12.0, dt, stationary=10.0)
+    n = env.size
+    t = np.arange(n) * dt
+    a = generate_ec8_record(seed=2, duration=12.0, stationary=10.0, max_iter=2).accel
+    periods = np.geomspace(lo, hi, synth._N_DENSE)
+    ratio = response_spectrum(a, dt, periods).psa / ec8_spectrum(1, "C", 0.3).psa(periods)
+    basis = np.vstack([env, env * t / t[-1]])
+    wv, wd = synth._end_state_weights(n, dt)
+    project = np.linalg.solve(np.array([[wv @ basis[0], wv @ basis[1]],
+                                        [wd @ basis[0], wd @ basis[1]]]), np.vstack([wv, wd]))
+    taper = np.minimum(1.0, env / 0.05)
+    length = n + int(np.ceil(hi / dt))
+    kernels = synth._sdof_kernels(lo, hi, synth._N_DENSE, zeta, dt, length)
+    ub = synth._basis_responses(lo, hi, zeta, dt, length, "trapezoidal", 12.0, 10.0)
+    out = [synth._wavelet_step(a, ratio, periods, kernels, dt, taper, basis, project, ub, ops)
+           for ops in (OPS_NUMBA, synth.OPS_NUMPY)]
+    assert np.max(np.abs(out[0] - a)) > 0.01 * np.max(np.abs(a))  # it corrects something
+    np.testing.assert_allclose(out[0], out[1], rtol=0, atol=1e-9 * np.max(np.abs(a)))

@@ -17,12 +17,14 @@ samples only (up to 1 - cos(π dt/T), 4.9 % at T = 10 dt). Two measures remove t
    velocity is located from the cubic Hermite interpolant of (u, u̇) at both ends, refined by one
    Newton step on the exact in-step solution, and the exact u there is taken.
 
-Free vibration after the record. By default (``free_vibration=True``) each oscillator is followed
-for one of its periods after the last sample with zero ground acceleration, which captures the
-first free-vibration peak: the record is taken as followed by rest (the acceleration returning
-linearly to zero over one time step), not as cut off. Pass
-``free_vibration=False`` to keep the maximum over the record duration only; this matters only for
-periods comparable with the duration of the record.
+Free vibration after the record. By default (``free_vibration=True``) the record is taken as
+followed by rest (the acceleration returning linearly to zero over one (sub-)step), not as cut
+off, and the peak of the free vibration that follows is included. It is found in closed form from
+the final state: |u| is largest at the start of the free vibration or at its first zero of
+velocity, within half a damped period (Chopra Eq. 2.2.4), so this equals following each
+oscillator for one of its periods, as the reference solutions in the tests and benchmark do. Pass
+``free_vibration=False`` to keep the maximum over the record duration only; this matters only
+for periods comparable with the duration of the record.
 
 Two implementations give the same numbers: a numba kernel (loop over periods, then steps) and a
 pure-numpy twin (vectorised over periods). ``backend="auto"`` uses numba when installed.
@@ -55,7 +57,7 @@ class Spectrum:
         psv: (n_T,) [m/s] pseudo-velocity ω·sd.
         psa: (n_T,) [m/s²] pseudo-acceleration ω²·sd (at T = 0: the peak ground acceleration).
         damping: viscous damping ratio ζ.
-        free_vibration: whether one free-vibration period after the record was included.
+        free_vibration: whether the free vibration after the record was included.
     """
 
     periods: np.ndarray
@@ -153,50 +155,84 @@ def _exact_peak(
 _REFINE = 0.99
 
 
+def _free_peak(u0: float, v0: float, w: float, z: float, wd: float) -> float:
+    """Largest |u| of the free vibration from ``(u0, v0)``: at t = 0 or at the first u̇ = 0."""
+    # u(t) = e^{-ζωt} (u0 cos θ + (v0 + ζω u0)/ωd sin θ), θ = ωd t (Chopra Eq. 2.2.4);
+    # u̇ ∝ Y cos θ - X sin θ with X = ω² u0 + ζω v0, Y = ωd v0: zero at θ = atan2(Y, X) + kπ.
+    # |u| at successive zeros of u̇ decays, and u is monotonic between them, so the first zero
+    # with θ > 0 (θ ≤ π: within half a damped period) and t = 0 bound the whole free vibration
+    th = math.atan2(wd * v0, w * w * u0 + z * w * v0)
+    if th <= 0.0:
+        th += math.pi
+    u1 = math.exp(-z * w * th / wd) * (u0 * math.cos(th) + (v0 + z * w * u0) / wd * math.sin(th))
+    return max(abs(u0), abs(u1))
+
+
 def _kernel_py(
-    p: np.ndarray, coef: tuple[np.ndarray, ...], w: np.ndarray, z: float, wd: np.ndarray,
-    h: float, cand: np.ndarray, out: np.ndarray,
+    p: np.ndarray, c: np.ndarray, z: float, h: float, free: bool, out: np.ndarray,
 ) -> None:
     """Scalar kernel (compiled by numba): max |u| over ``p`` for each oscillator into ``out``.
 
+    ``c`` (11, n_osc) holds, per oscillator, the eight step coefficients of
+    :func:`step_coefficients`, then ω, ω_d and the candidate threshold (one array: one argument
+    to unbox per call).
+
     Steps are the outer loop and oscillators the inner one: the oscillators' recurrences are
-    independent, so the CPU overlaps them instead of waiting on one dependency chain.
+    independent, so the inner loop has no branch and compiles to SIMD instructions; the rare
+    in-step peak candidates it flags are handled in a second loop. With ``free``, the largest
+    |u| of the free vibration from the final state is added (:func:`_free_peak`).
     """
     n = p.shape[0]
-    nper = w.shape[0]
-    a11, a12, a21, a22, b10, b11, b20, b21 = coef
+    nper = c.shape[1]
+    a11, a12, a21, a22, b10, b11, b20, b21 = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]
+    w, wd, cand = c[8], c[9], c[10]
     u = np.zeros(nper)
     v = np.zeros(nper)
+    un = np.zeros(nper)
+    vn = np.zeros(nper)
     umax = np.zeros(nper)
+    flag = np.zeros(nper, dtype=np.int64)
     for k in range(n - 1):
         p0 = p[k]
         p1 = p[k + 1]
+        nhit = 0
         for i in range(nper):
             ui = u[i]
             vi = v[i]
             u1 = a11[i] * ui + a12[i] * vi + b10[i] * p0 + b11[i] * p1
             v1 = a21[i] * ui + a22[i] * vi + b20[i] * p0 + b21[i] * p1
-            u[i] = u1
-            v[i] = v1
+            un[i] = u1
+            vn[i] = v1
             um = umax[i]
             au = abs(u1)
-            if au > um:
-                umax[i] = au
-            if vi * v1 < 0.0 and max(abs(ui), au) > cand[i] * um:
-                s, hp = _hermite_peak_nb(ui, vi, u1, v1, h)
-                if abs(hp) > _REFINE * umax[i]:
-                    pk = _exact_peak_nb(ui, vi, p0, p1, s, w[i], z, wd[i], h)
-                    if pk > umax[i]:
-                        umax[i] = pk
+            umax[i] = au if au > um else um
+            # a sign change of u̇ near the running maximum: a peak may lie inside the step
+            f = int(vi * v1 < 0.0) & int(max(abs(ui), au) > cand[i] * um)
+            flag[i] = f
+            nhit += f
+        if nhit > 0:
+            for i in range(nper):
+                if flag[i] != 0:
+                    s, hp = _hermite_peak_nb(u[i], v[i], un[i], vn[i], h)
+                    if abs(hp) > _REFINE * umax[i]:
+                        pk = _exact_peak_nb(u[i], v[i], p0, p1, s, w[i], z, wd[i], h)
+                        if pk > umax[i]:
+                            umax[i] = pk
+        u, un = un, u
+        v, vn = vn, v
+    if free:
+        for i in range(nper):
+            pk = _free_peak_nb(u[i], v[i], w[i], z, wd[i])
+            if pk > umax[i]:
+                umax[i] = pk
     out[:] = umax
 
 
 def _kernel_numpy(
-    p: np.ndarray, coef: tuple[np.ndarray, ...], w: np.ndarray, z: float, wd: np.ndarray,
-    h: float, cand: np.ndarray, out: np.ndarray,
+    p: np.ndarray, c: np.ndarray, z: float, h: float, free: bool, out: np.ndarray,
 ) -> None:
     """Pure-numpy twin of the kernel: the same recurrence and tests, vectorised over oscillators."""
-    a11, a12, a21, a22, b10, b11, b20, b21 = coef
+    a11, a12, a21, a22, b10, b11, b20, b21, w, wd, cand = c
     u = np.zeros(w.size)
     v = np.zeros(w.size)
     umax = np.zeros(w.size)
@@ -214,21 +250,23 @@ def _kernel_numpy(
                 pk = _exact_peak(u[i], v[i], p0, p1, s, w[i], z, wd[i], h)
                 umax[i] = max(umax[i], pk)
         u, v = u1, v1
+    if free:
+        for i in range(w.size):
+            umax[i] = max(umax[i], _free_peak(u[i], v[i], w[i], z, wd[i]))
     out[:] = umax
 
 
 if HAVE_NUMBA:
     _hermite_peak_nb = _numba.njit(cache=True)(_hermite_peak)
     _exact_peak_nb = _numba.njit(cache=True)(_exact_peak)
+    _free_peak_nb = _numba.njit(cache=True)(_free_peak)
     _kernel_nb = _numba.njit(cache=True)(_kernel_py)
 else:  # pragma: no cover
     _hermite_peak_nb = _hermite_peak
     _exact_peak_nb = _exact_peak
+    _free_peak_nb = _free_peak
     _kernel_nb = None
 
-# oscillators are processed in groups of similar period, so that the zero padding for the
-# free vibration after the record (one period of the longest oscillator of the group) stays short
-_GROUP = 40
 
 
 def response_spectrum(
@@ -248,7 +286,7 @@ def response_spectrum(
         dt: [s] time step.
         periods: (n_T,) [s] oscillator periods, ≥ 0 (T = 0 gives the peak ground acceleration).
         damping: viscous damping ratio ζ in [0, 1).
-        free_vibration: follow each oscillator one period past the end of the record (see the
+        free_vibration: include the free vibration after the end of the record (see the
             module docstring).
         points_per_period: minimum number of (sub-)steps per oscillator period.
         backend: ``"auto"``, ``"numba"`` or ``"numpy"``.
@@ -276,29 +314,8 @@ def response_spectrum(
     pos = T > 0
     Tp = T[pos]
     z = float(damping)
-    sd_p = np.empty(Tp.size)
-    p = -a
-    kernel = _kernel_nb if backend == "numba" else _kernel_numpy
-    m_all = np.maximum(1, np.ceil(points_per_period * dt / Tp - 1e-9)).astype(np.int64)
-    order = np.lexsort((Tp, m_all))
-    for mi in np.unique(m_all):
-        sel = order[m_all[order] == mi]
-        h = dt / mi
-        # sub-steps: linear interpolation of the input is exact for piecewise-linear input
-        grid = np.arange((p.size - 1) * mi + 1) / mi
-        pm = p if mi == 1 else np.interp(grid, np.arange(p.size), p)
-        for start in range(0, sel.size, _GROUP):
-            idx = sel[start:start + _GROUP]
-            w = 2.0 * np.pi / Tp[idx]
-            wd = w * math.sqrt(1.0 - z * z)
-            if free_vibration:  # zeros for one period of the longest oscillator of the group
-                pk = np.concatenate([pm, np.zeros(int(math.ceil(Tp[idx].max() / h)) + 1)])
-            else:
-                pk = pm
-            cand = 0.9 * np.cos(np.minimum(0.5 * wd * h, 0.5 * np.pi))
-            out = np.empty(idx.size)
-            kernel(pk, step_coefficients(w, z, h), w, z, wd, h, cand, out)
-            sd_p[idx] = out
+    plan = spectrum_plan(Tp, float(dt), z, points_per_period)
+    sd_p = peak_displacements(-a, plan, free_vibration=free_vibration, backend=backend)
     w_all = 2.0 * np.pi / Tp
     sd = np.zeros(T.size)
     psv = np.zeros(T.size)
@@ -307,3 +324,59 @@ def response_spectrum(
     psv[pos] = w_all * sd_p
     psa[pos] = w_all * w_all * sd_p
     return Spectrum(T.copy(), sd, psv, psa, z, bool(free_vibration))
+
+
+@dataclass(frozen=True, eq=False)
+class SpectrumPlan:
+    """Everything in a response spectrum that depends on the periods only, not on the record.
+
+    ``damping``: ζ; ``groups``: one ``(m, idx, h, c)`` per number m of sub-steps per record
+    step: the indices ``idx`` of the periods so integrated, the sub-step h [s] and the packed
+    kernel parameters ``c`` (11, idx.size) (see :func:`_kernel_py`). Built by
+    :func:`spectrum_plan`; reused when many records are measured at the same periods (the
+    accelerogram generator does so).
+    """
+
+    n_periods: int
+    damping: float
+    groups: tuple[tuple[int, np.ndarray, float, np.ndarray], ...]
+
+
+def spectrum_plan(periods: np.ndarray, dt: float, damping: float,
+                  points_per_period: int = 10) -> SpectrumPlan:
+    """Plan for :func:`peak_displacements` at ``periods`` (n_T,) [s] > 0, unchecked."""
+    Tp = np.asarray(periods, dtype=np.float64)
+    m_all = np.maximum(1, np.ceil(points_per_period * dt / Tp - 1e-9)).astype(np.int64)
+    order = np.lexsort((Tp, m_all))
+    groups = []
+    for mi in np.unique(m_all):
+        idx = order[m_all[order] == mi]
+        h = dt / mi
+        w = 2.0 * np.pi / Tp[idx]
+        wd = w * math.sqrt(1.0 - damping * damping)
+        cand = 0.9 * np.cos(np.minimum(0.5 * wd * h, 0.5 * np.pi))
+        c = np.ascontiguousarray(np.vstack([*step_coefficients(w, damping, h), w, wd, cand]))
+        groups.append((int(mi), idx, h, c))
+    return SpectrumPlan(Tp.size, float(damping), tuple(groups))
+
+
+def peak_displacements(p: np.ndarray, plan: SpectrumPlan, *, free_vibration: bool = True,
+                       backend: str = "numba") -> np.ndarray:
+    """Peak relative displacements (n_T,) [m] under the load ``p = -a_g`` (n,) [m/s²], unchecked.
+
+    The core of :func:`response_spectrum`, for callers that validated their input already.
+    """
+    kernel = _kernel_nb if backend == "numba" and HAVE_NUMBA else _kernel_numpy
+    z = plan.damping
+    sd = np.empty(plan.n_periods)
+    for mi, idx, h, c in plan.groups:
+        # sub-steps: linear interpolation of the input is exact for piecewise-linear input
+        pm = p if mi == 1 else np.interp(np.arange((p.size - 1) * mi + 1) / mi,
+                                         np.arange(p.size), p)
+        # after the record: the input returns linearly to zero over one (sub-)step, then the
+        # free vibration is taken in closed form
+        pk = np.append(pm, 0.0) if free_vibration else pm
+        out = np.empty(idx.size)
+        kernel(pk, c, z, h, bool(free_vibration), out)
+        sd[idx] = out
+    return sd

@@ -19,7 +19,8 @@ inside both loops:
    most, under a Gaussian window about one period long), and the wavelet amplitudes solve, in
    the least-squares sense with a small Tikhonov term, the *linear* equations "response at the
    peak times = aim". The response of every constrained oscillator to every wavelet is exact
-   (discrete convolution with the oscillator's kernel for piecewise-linear input). The secondary
+   (discrete convolution with the oscillator's kernel for piecewise-linear input, the kernel cut
+   where it has decayed below 1e-6, the window where it is below 1e-6). The secondary
    peaks of each response (≥ 75 % of the largest, in other half-cycles) enter as equations too:
    held where they are or pushed under the aim (without them the peak jumps to another cycle and
    the iteration oscillates), or raised with the primary peak when both are nearly equal and
@@ -41,15 +42,21 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
-import scipy.fft
 
 from seisrack.errors import InputError
 from seisrack.motion.ec8 import DesignSpectrum, ec8_spectrum
 from seisrack.motion.records import Record
-from seisrack.motion.spectra import response_spectrum, step_coefficients
+from seisrack.motion.spectra import peak_displacements, spectrum_plan, step_coefficients
+
+try:  # optional accelerator (as in spectra.py); without it the numpy twins run
+    import numba as _numba
+except ImportError:  # pragma: no cover - exercised where numba is absent
+    _numba = None
 
 log = logging.getLogger(__name__)
 
@@ -72,6 +79,8 @@ _HOLD = 0.97
 _RAISE = 0.9
 _W_PRIMARY = 3.0
 _RIDGE = 1e-4
+# a wavelet's Gaussian window is cut _CUT widths after its centre (e^{-_CUT²} < 1e-6)
+_CUT = 3.8
 ENVELOPES = ("trapezoidal", "jennings", "saragoni-hart")
 
 
@@ -146,12 +155,15 @@ def _baseline(a: np.ndarray, basis: np.ndarray, wv: np.ndarray, wd: np.ndarray) 
 
 @lru_cache(maxsize=8)
 def _sdof_kernels(
-    lo: float, hi: float, n_per: int, zeta: float, dt: float, length: int, nfft: int,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Discrete response kernels G (n_per, length), their rFFT and the wavelet shapes.
+    lo: float, hi: float, n_per: int, zeta: float, dt: float, length: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Discrete response kernels and wavelet shapes of the dense-grid oscillators.
 
-    Returns ``G``, ``rfft(G, nfft)`` (n_per, nfft // 2 + 1) and ``Gw`` (n_per, length): G under
-    the wavelet window (see :func:`_wavelet_step`).
+    Returns ``Gr`` (n_per, length): the kernels G reversed in time (``Gr[i, length-1-m] =
+    G_i[m]``), ``Gwr`` (n_per, length): the wavelet shapes (G under the wavelet window, see
+    :func:`_wavelet_step`) reversed likewise, ``lw`` (n_per,): the wavelet lengths (the window
+    cut where it is below 1e-6), ``lg`` (n_per,): the kernel lengths (G is zero from there on,
+    see below) and ``coef`` (8, n_per): the step coefficients.
 
     ``u_i[m] = Σ_k G_i[m - k] p_k`` is the exact relative displacement at sample m of oscillator
     i (periods ``geomspace(lo, hi, n_per)``) under the piecewise-linear load p (p_0 = 0), from
@@ -161,7 +173,8 @@ def _sdof_kernels(
     """
     w = 2.0 * np.pi / np.geomspace(lo, hi, n_per)
     wd = w * math.sqrt(1.0 - zeta * zeta)
-    a11, a12, a21, a22, b10, b11, b20, b21 = step_coefficients(w, zeta, dt)
+    coef = np.array(step_coefficients(w, zeta, dt))
+    a11, a12, a21, a22, b10, b11, b20, b21 = coef
     u1 = a11 * b11 + a12 * b21 + b10
     v1 = a21 * b11 + a22 * b21 + b20
     tau = np.arange(length - 1) * dt
@@ -171,26 +184,290 @@ def _sdof_kernels(
         u1[:, None] * np.cos(wd[:, None] * tau)
         + ((v1 + zeta * w * u1) / wd)[:, None] * np.sin(wd[:, None] * tau)
     )
-    Gf = scipy.fft.rfft(G, nfft)
     # wavelet j = oscillator j's kernel reversed about its peak time (a matched filter) under a
-    # Gaussian window one period wide, centred one period before the peak
-    T = 2.0 * np.pi / w[:, None]
-    Gw = G * np.exp(-(((np.arange(length) * dt - T) / T) ** 2))
-    for arr in (G, Gf, Gw):
+    # Gaussian window one period wide, centred one period before the peak, cut after
+    # (1 + _CUT) periods where the window is below e^{-_CUT²} < 1e-6
+    T = 2.0 * np.pi / w
+    Gw = G * np.exp(-(((np.arange(length) * dt - T[:, None]) / T[:, None]) ** 2))
+    lw = np.minimum(length, np.ceil((1.0 + _CUT) * T / dt).astype(np.int64) + 1)
+    # the kernels are cut where they have decayed below 1e-6 (e^{-ζωτ}, 44 periods at 5 %):
+    # the predicted responses are then off by < 1e-6 relative, and the short-period ones cost
+    # far fewer operations
+    lg = np.full(w.size, length, dtype=np.int64)
+    if zeta > 0:
+        lg = np.minimum(length, np.ceil(math.log(1e6) / (zeta * w * dt)).astype(np.int64))
+    for i, li in enumerate(lg):
+        G[i, li:] = 0.0
+    Gr = np.ascontiguousarray(G[:, ::-1])
+    Gwr = np.ascontiguousarray(Gw[:, ::-1])
+    for arr in (Gr, Gwr, lw, lg, coef):
         arr.flags.writeable = False
-    return G, Gf, Gw
+    return Gr, Gwr, lw, lg, coef
+
+
+@lru_cache(maxsize=4)
+def _basis_responses(
+    lo: float, hi: float, zeta: float, dt: float, length: int, envelope_kind: str,
+    duration: float, stationary: float | None,
+) -> np.ndarray:
+    """(2, _N_DENSE, length): u of every dense-grid oscillator under each baseline function."""
+    env, _ = envelope(envelope_kind, duration, dt, stationary=stationary)
+    t = np.arange(env.size) * dt
+    coef = _sdof_kernels(lo, hi, _N_DENSE, zeta, dt, length)[4]
+    ops = OPS_NUMBA if OPS_NUMBA is not None else OPS_NUMPY
+    ub = np.empty((2, _N_DENSE, length))
+    for k, f in enumerate((env, env * t / t[-1])):
+        ops.responses(f, coef, ub[k])
+    ub.flags.writeable = False
+    return ub
+
+
+# Kernels of the wavelet stage. Each is written once as loops (compiled by numba when installed)
+# and has a numpy twin (used without numba, and by the parity test).
+
+
+def _responses_py(p: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
+    """out (n_osc, length): u of each oscillator at samples 0… under p (n,), then p = 0; p_0 = 0."""
+    n = p.shape[0]
+    nosc = coef.shape[1]
+    a11, a12, a21, a22 = coef[0], coef[1], coef[2], coef[3]
+    b10, b11, b20, b21 = coef[4], coef[5], coef[6], coef[7]
+    u = np.zeros(nosc)
+    v = np.zeros(nosc)
+    out[:, 0] = 0.0
+    # steps outside, oscillators inside: independent recurrences overlap in the CPU
+    for k in range(out.shape[1] - 1):
+        p0 = p[k] if k < n else 0.0
+        p1 = p[k + 1] if k + 1 < n else 0.0
+        for i in range(nosc):
+            ui = u[i]
+            vi = v[i]
+            u1 = a11[i] * ui + a12[i] * vi + b10[i] * p0 + b11[i] * p1
+            v[i] = a21[i] * ui + a22[i] * vi + b20[i] * p0 + b21[i] * p1
+            u[i] = u1
+            out[i, k + 1] = u1
+
+
+def _responses_np(p: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
+    a11, a12, a21, a22, b10, b11, b20, b21 = coef
+    pp = np.zeros(out.shape[1])
+    pp[: p.size] = p
+    u = np.zeros(coef.shape[1])
+    v = np.zeros(coef.shape[1])
+    out[:, 0] = 0.0
+    for k in range(out.shape[1] - 1):
+        u, v = (a11 * u + a12 * v + b10 * pp[k] + b11 * pp[k + 1],
+                a21 * u + a22 * v + b20 * pp[k] + b21 * pp[k + 1])
+        out[:, k + 1] = u
+
+
+def _peaks_py(u: np.ndarray, m_end: np.ndarray, half: np.ndarray, out: np.ndarray) -> None:
+    """out (n_osc, n_peaks): sample of the largest |u[i, :m_end_i + 1]|, then of the largest
+    outside ±half_i of those already found (0 when none is left)."""
+    au = np.empty(u.shape[1])
+    for i in range(u.shape[0]):
+        me = m_end[i]
+        for m in range(me + 1):
+            au[m] = abs(u[i, m])
+        for q in range(out.shape[1]):
+            best = 0
+            bv = au[0]
+            for m in range(1, me + 1):
+                if au[m] > bv:
+                    bv = au[m]
+                    best = m
+            out[i, q] = best
+            for m in range(max(best - half[i], 0), min(best + half[i], me) + 1):
+                au[m] = 0.0
+
+
+def _peaks_np(u: np.ndarray, m_end: np.ndarray, half: np.ndarray, out: np.ndarray) -> None:
+    au = np.abs(u[:, : m_end.max() + 1])
+    for row, me in enumerate(m_end):
+        au[row, me + 1:] = 0.0
+    for q in range(out.shape[1]):
+        out[:, q] = np.argmax(au, axis=1)
+        for row, (mr, h) in enumerate(zip(out[:, q], half, strict=True)):
+            au[row, max(mr - h, 0): mr + h + 1] = 0.0
+
+
+def _wavelets_py(
+    Gwr: np.ndarray, lw: np.ndarray, osc: np.ndarray, mpk: np.ndarray, taper: np.ndarray,
+    project: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray, cF: np.ndarray,
+) -> None:
+    """Wavelet j (oscillator osc_j, peak at sample mpk_j) into F[j, fs_j:fe_j + 1] (F zero
+    elsewhere), and its baseline coefficients ``cF[:, j] = project @ F[j]``."""
+    L = Gwr.shape[1]
+    n = F.shape[1]
+    for j in range(osc.shape[0]):
+        i = osc[j]
+        m = mpk[j]
+        s = max(0, m - lw[i] + 1)
+        e = min(m, n - 1)
+        fs[j] = s
+        fe[j] = e
+        c0 = 0.0
+        c1 = 0.0
+        for k in range(s, e + 1):
+            f = Gwr[i, L - 1 - m + k] * taper[k]
+            F[j, k] = f
+            c0 += project[0, k] * f
+            c1 += project[1, k] * f
+        cF[0, j] = c0
+        cF[1, j] = c1
+
+
+def _wavelets_np(
+    Gwr: np.ndarray, lw: np.ndarray, osc: np.ndarray, mpk: np.ndarray, taper: np.ndarray,
+    project: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray, cF: np.ndarray,
+) -> None:
+    L = Gwr.shape[1]
+    fs[:] = np.maximum(0, mpk - lw[osc] + 1)
+    fe[:] = np.minimum(mpk, F.shape[1] - 1)
+    for j, (i, m, s, e) in enumerate(zip(osc, mpk, fs, fe, strict=True)):
+        F[j, s:e + 1] = Gwr[i, L - 1 - m + s: L - m + e] * taper[s:e + 1]
+    cF[:] = project @ F.T
+
+
+def _dots_py(
+    Gr: np.ndarray, lg: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray,
+    osc: np.ndarray, m: np.ndarray, out: np.ndarray,
+) -> None:
+    """out[r, j] = Σ_k G_{osc_r}[m_r - k] F[j, k]: oscillator osc_r's u at sample m_r under
+    wavelet j (zero when the wavelet starts after m_r; G_i is zero from lg_i on)."""
+    L = Gr.shape[1]
+    for r in range(osc.shape[0]):
+        g = Gr[osc[r]]
+        off = L - 1 - m[r]
+        k0 = m[r] - lg[osc[r]] + 1
+        for j in range(fs.shape[0]):
+            lo = max(fs[j], k0)
+            hi = min(fe[j], m[r])
+            s = 0.0
+            if hi >= lo:  # contiguous slices: the loop compiles to SIMD
+                gs = g[off + lo: off + hi + 1]
+                f = F[j, lo: hi + 1]
+                for t in range(gs.shape[0]):
+                    s += gs[t] * f[t]
+            out[r, j] = s
+
+
+def _dots_np(
+    Gr: np.ndarray, lg: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray,
+    osc: np.ndarray, m: np.ndarray, out: np.ndarray,
+) -> None:
+    L, n = Gr.shape[1], F.shape[1]
+    W = np.zeros((osc.size, n))
+    for row, (i, mr) in enumerate(zip(osc, m, strict=True)):
+        j = min(int(mr), n - 1)
+        W[row, : j + 1] = Gr[i, L - 1 - mr: L - mr + j]
+    out[:] = W @ F.T
+
+
+def _lsq_py(A: np.ndarray, rhs: np.ndarray, ridge: float, out: np.ndarray) -> None:
+    """out = (AᵀA + ridge I)⁻¹ Aᵀ rhs: normal equations, Cholesky AᵀA + ridge I = UᵀU."""
+    R, K = A.shape
+    N = np.zeros((K, K))
+    y = np.zeros(K)
+    At = np.ascontiguousarray(A.T)
+    for i in range(K):  # AᵀA and Aᵀ rhs: contiguous dot products (SIMD)
+        ai = At[i]
+        s = 0.0
+        for r in range(R):
+            s += ai[r] * rhs[r]
+        y[i] = s
+        for j in range(i, K):
+            aj = At[j]
+            s = 0.0
+            for r in range(R):
+                s += ai[r] * aj[r]
+            N[i, j] = s
+    for i in range(K):
+        N[i, i] += ridge
+    for j in range(K):  # right-looking Cholesky on the upper triangle
+        d = math.sqrt(N[j, j])
+        for i in range(j, K):
+            N[j, i] /= d
+        for i in range(j + 1, K):
+            nji = N[j, i]
+            Ni = N[i, i:]
+            Nj = N[j, i:]
+            for l2 in range(Ni.shape[0]):
+                Ni[l2] -= nji * Nj[l2]
+    for k in range(K):  # Uᵀ z = y
+        y[k] /= N[k, k]
+        for i in range(k + 1, K):
+            y[i] -= N[k, i] * y[k]
+    for i in range(K - 1, -1, -1):  # U x = z
+        s = y[i]
+        for l2 in range(i + 1, K):
+            s -= N[i, l2] * out[l2]
+        out[i] = s / N[i, i]
+
+
+def _lsq_np(A: np.ndarray, rhs: np.ndarray, ridge: float, out: np.ndarray) -> None:
+    out[:] = np.linalg.solve(A.T @ A + ridge * np.eye(A.shape[1]), A.T @ rhs)
+
+
+def _add_py(
+    a: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray, c: np.ndarray,
+    basis: np.ndarray, cF: np.ndarray, out: np.ndarray,
+) -> None:
+    """out = a + Σ_j c_j (F_j - cF_j · basis): the baseline-corrected wavelets added."""
+    g0 = 0.0
+    g1 = 0.0
+    out[:] = a
+    for j in range(fs.shape[0]):
+        cj = c[j]
+        g0 += cj * cF[0, j]
+        g1 += cj * cF[1, j]
+        for k in range(fs[j], fe[j] + 1):
+            out[k] += cj * F[j, k]
+    for k in range(out.shape[0]):
+        out[k] -= g0 * basis[0, k] + g1 * basis[1, k]
+
+
+def _add_np(
+    a: np.ndarray, F: np.ndarray, fs: np.ndarray, fe: np.ndarray, c: np.ndarray,
+    basis: np.ndarray, cF: np.ndarray, out: np.ndarray,
+) -> None:
+    out[:] = a + c @ F - (cF @ c) @ basis
+
+
+class _Ops(NamedTuple):
+    responses: Callable[..., None]
+    peaks: Callable[..., None]
+    wavelets: Callable[..., None]
+    dots: Callable[..., None]
+    lsq: Callable[..., None]
+    add: Callable[..., None]
+
+
+OPS_NUMPY = _Ops(_responses_np, _peaks_np, _wavelets_np, _dots_np, _lsq_np, _add_np)
+if _numba is not None:
+    _jit = _numba.njit(cache=True)
+    OPS_NUMBA: _Ops | None = _Ops(
+        _jit(_responses_py), _jit(_peaks_py), _jit(_wavelets_py),
+        # the two kernels whose sums are left to the compiler to order (SIMD dot products)
+        _numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz"})(_dots_py),
+        _numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz"})(_lsq_py),
+        _jit(_add_py),
+    )
+else:  # pragma: no cover
+    OPS_NUMBA = None
 
 
 def _wavelet_step(
     a: np.ndarray, ratio: np.ndarray, periods: np.ndarray,
-    kernels: tuple[np.ndarray, np.ndarray, np.ndarray], nfft: int, dt: float,
-    taper: np.ndarray, basis: np.ndarray, project: np.ndarray,
+    kernels: tuple[np.ndarray, ...], dt: float,
+    taper: np.ndarray, basis: np.ndarray, project: np.ndarray, ub: np.ndarray, ops: _Ops,
 ) -> np.ndarray:
     """One time-domain correction of ``a`` (n,) [m/s²]; ratio (n_T,) = computed / aimed spectrum.
 
-    See step 4 of the module docstring. Returns the corrected, baseline-corrected record.
+    See step 4 of the module docstring. ``ub`` (2, n_T, L): response of each dense-grid
+    oscillator to each baseline function. Returns the corrected, baseline-corrected record.
     """
-    G, Gf, Gw = kernels
+    Gr, Gwr, lw, lg, coef = kernels
     n = a.size
     x = ratio - 1.0
     sel = np.zeros(x.size, dtype=bool)
@@ -201,59 +478,55 @@ def _wavelet_step(
     idx_T = np.flatnonzero(sel)
     T = periods[idx_T]
     r = ratio[idx_T]
+    K = idx_T.size
     # response histories up to one period after the record (as response_spectrum's default)
     m_end = n - 1 + np.ceil(T / dt).astype(np.int64)
-    u = scipy.fft.irfft(scipy.fft.rfft(-a, nfft)[None, :] * Gf[idx_T], nfft)
+    u = np.empty((K, int(m_end.max()) + 1))
+    ops.responses(-a, np.ascontiguousarray(coef[:, idx_T]), u)
     # primary and secondary peaks: each further peak outside ±0.3 T of those already found
-    au = np.abs(u[:, : m_end.max() + 1])
-    for row, me in enumerate(m_end):
-        au[row, me + 1:] = 0.0
-    half = np.ceil(0.3 * T / dt).astype(np.int64)
-    peaks = []
-    for _ in range(_N_PEAKS):
-        mq = np.argmax(au, axis=1)
-        peaks.append(mq)
-        for row, (mr, h) in enumerate(zip(mq, half, strict=True)):
-            au[row, max(mr - h, 0): mr + h + 1] = 0.0
-    rows = np.arange(T.size)
-
-    def kernel_rows(K: np.ndarray, i_osc: np.ndarray, m: np.ndarray) -> np.ndarray:
-        # out[r, k] = K_i[m_r - k] (zero for k > m_r): the kernel reversed about m_r; K is
-        # long enough (the record plus one longest period) for every m_r
-        out = np.zeros((i_osc.size, n))
-        for row, (i, mr) in enumerate(zip(idx_T[i_osc], m, strict=True)):
-            j = min(int(mr), n - 1)
-            out[row, : j + 1] = K[i, mr - j : mr + 1][::-1]
-        return out
-
-    m1 = peaks[0]
+    peaks = np.empty((K, _N_PEAKS), dtype=np.int64)
+    ops.peaks(u, m_end, np.ceil(0.3 * T / dt).astype(np.int64), peaks)
+    rows = np.arange(K)
+    m1 = peaks[:, 0]
     u1 = u[rows, m1]
-    W = kernel_rows(G, rows, m1)
-    F = kernel_rows(Gw, rows, m1) * taper
-    F /= np.abs(F).max(axis=1, keepdims=True)
-    F -= (F @ project.T) @ basis  # baseline-corrected wavelets
-    C = -(W @ F.T) / u1[:, None]  # relative change of peak i per unit amplitude of wavelet j
-    d = np.diag(C).copy()
-    C /= d[None, :]
-    F /= d[:, None]
-    eqs = [_W_PRIMARY * C]
+    # the equations: one per primary peak (row j: wavelet j's own peak), then the secondary
+    # peaks (≥ _SECONDARY × the primary, in other half-cycles)
+    eq_osc, eq_m, eq_u = [idx_T], [m1], [u1]
     rhs = [_W_PRIMARY * (1.0 / r - 1.0)]
-    for mq in peaks[1:]:
+    for q in range(1, _N_PEAKS):
+        mq = peaks[:, q]
         uq = u[rows, mq]
         lvl = np.abs(uq) / np.abs(u1)
         keep = lvl >= _SECONDARY
-        if keep.any():
-            Wq = kernel_rows(G, rows[keep], mq[keep])
-            eqs.append(-(Wq @ F.T) / uq[keep][:, None])
-            rq, lq = r[keep], lvl[keep]
-            # below the aim, a near-equal peak is raised with the primary: the spectrum then
-            # has no V-shaped dip where the two peaks cross over in period; otherwise a
-            # secondary peak is held, or pushed under the aim
-            rhs.append(np.where((rq < 1.0) & (lq >= _RAISE), 1.0 / rq - 1.0,
-                                np.minimum(0.0, _HOLD / (rq * lq) - 1.0)))
-    A = np.vstack(eqs)
-    b = np.linalg.solve(A.T @ A + _RIDGE * np.eye(T.size), A.T @ np.concatenate(rhs))
-    return a + b @ F
+        eq_osc.append(idx_T[keep])
+        eq_m.append(mq[keep])
+        eq_u.append(uq[keep])
+        rq, lq = r[keep], lvl[keep]
+        # below the aim, a near-equal peak is raised with the primary: the spectrum then
+        # has no V-shaped dip where the two peaks cross over in period; otherwise a
+        # secondary peak is held, or pushed under the aim
+        rhs.append(np.where((rq < 1.0) & (lq >= _RAISE), 1.0 / rq - 1.0,
+                            np.minimum(0.0, _HOLD / (rq * lq) - 1.0)))
+    osc_all, m_all, u_all = (np.concatenate(v) for v in (eq_osc, eq_m, eq_u))
+    F = np.zeros((K, n))
+    fs = np.empty(K, dtype=np.int64)
+    fe = np.empty(K, dtype=np.int64)
+    cF = np.empty((2, K))
+    ops.wavelets(Gwr, lw, idx_T, m1, taper, project, F, fs, fe, cF)
+    D = np.empty((osc_all.size, K))
+    ops.dots(Gr, lg, F, fs, fe, osc_all, m_all, D)
+    # the wavelets are baseline-corrected (F_j - cF_j · basis), so the solve sees exactly what
+    # is added; D then holds the change of each constrained u per unit amplitude of wavelet j
+    D -= ub[0, osc_all, m_all][:, None] * cF[0] + ub[1, osc_all, m_all][:, None] * cF[1]
+    C = D / -u_all[:, None]  # relative change of peak i per unit amplitude of wavelet j
+    d = C[rows, rows].copy()
+    C /= d[None, :]
+    C[:K] *= _W_PRIMARY
+    b = np.empty(K)
+    ops.lsq(C, np.concatenate(rhs), _RIDGE, b)
+    out = np.empty(n)
+    ops.add(a, F, fs, fe, b / d, basis, cF, out)
+    return out
 
 
 def generate_ec8_record(
@@ -347,19 +620,25 @@ def generate_ec8_record(
     a = _baseline(np.fft.irfft(X, nfft)[:n] * env, basis, wv, wd)
     # keeps the start and end at zero after each correction (the envelope's own ramps)
     taper = np.minimum(1.0, env / 0.05)
+    # the dense-grid spectrum is measured every iteration: its period-only part is built once
+    plan = spectrum_plan(periods, float(dt), zeta)
+    w2 = (2.0 * np.pi / periods) ** 2
+    backend = "numba" if OPS_NUMBA is not None else "numpy"
+
+    def psa(acc: np.ndarray) -> np.ndarray:
+        return w2 * peak_displacements(-acc, plan, backend=backend)
+
     # scale once to the target level before the shape iteration
-    sa = response_spectrum(a, dt, periods, zeta).psa
-    a *= float(np.exp(np.mean(np.log(target / sa))))
-    # time-domain stage: kernels long enough for the record plus one longest period, and an FFT
-    # long enough for that linear convolution not to wrap
-    m_max = n + int(math.ceil(hi / dt))
-    nconv = scipy.fft.next_fast_len(m_max + n, real=True)
-    kernels = None
+    a *= float(np.exp(np.mean(np.log(target / psa(a)))))
+    # time-domain stage: kernels long enough for the record plus one longest period
+    m_max = n - 1 + int(math.ceil(hi / dt))
+    kernels = ub = None
+    ops = OPS_NUMBA if OPS_NUMBA is not None else OPS_NUMPY
     best, best_mis = a, np.inf
     it = 0
     while it < max_iter:
         it += 1
-        ratio = response_spectrum(a, dt, periods, zeta).psa / target
+        ratio = psa(a) / target
         mis = float(np.max(np.abs(ratio[inner] - 1.0)))
         if mis < best_mis:
             best, best_mis = a, mis
@@ -372,10 +651,12 @@ def generate_ec8_record(
             a = _baseline(np.fft.irfft(spec, nfft)[:n] * taper, basis, wv, wd)
         else:
             if kernels is None:
-                kernels = _sdof_kernels(lo, hi, _N_DENSE, zeta, float(dt), nconv - n + 1, nconv)
-            a = _wavelet_step(a, ratio, periods, kernels, nconv, dt, taper, basis, project)
+                kernels = _sdof_kernels(lo, hi, _N_DENSE, zeta, float(dt), m_max + 1)
+                ub = _basis_responses(lo, hi, zeta, float(dt), m_max + 1, envelope_kind,
+                                      float(duration), stationary)
+            a = _wavelet_step(a, ratio, periods, kernels, dt, taper, basis, project, ub, ops)
     else:
-        ratio = response_spectrum(a, dt, periods, zeta).psa / target
+        ratio = psa(a) / target
         mis = float(np.max(np.abs(ratio[inner] - 1.0)))
         if mis < best_mis:
             best, best_mis = a, mis
