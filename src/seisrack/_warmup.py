@@ -29,6 +29,11 @@ def warmup() -> dict[str, float]:
 
     response_spectrum(np.sin(np.arange(400) * 0.1), 0.01, np.array([0.05, 0.5, 2.0]))
     timings["response spectrum"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    from seisrack.motion import generate_ec8_record
+
+    generate_ec8_record(type=1, ground="C", ag=0.1, duration=12.0, dt=0.01, seed=0)
+    timings["accelerogram synthesis"] = time.perf_counter() - t0
     return timings
 
 
