@@ -15,8 +15,10 @@ import numpy as np
 
 try:  # optional accelerator; without it the numpy twins run
     import numba as _numba
+    from numba import prange
 except ImportError:  # pragma: no cover - exercised where numba is absent
     _numba = None
+    prange = range
 
 
 def _responses_py(p: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
@@ -25,19 +27,17 @@ def _responses_py(p: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
     nosc = coef.shape[1]
     a11, a12, a21, a22 = coef[0], coef[1], coef[2], coef[3]
     b10, b11, b20, b21 = coef[4], coef[5], coef[6], coef[7]
-    u = np.zeros(nosc)
-    v = np.zeros(nosc)
-    out[:, 0] = 0.0
-    # steps outside, oscillators inside: independent recurrences overlap in the CPU
-    for k in range(out.shape[1] - 1):
-        p0 = p[k] if k < n else 0.0
-        p1 = p[k + 1] if k + 1 < n else 0.0
-        for i in range(nosc):
-            ui = u[i]
-            vi = v[i]
+    # oscillators are independent: one recurrence per oscillator, spread over the cores
+    for i in prange(nosc):
+        ui = 0.0
+        vi = 0.0
+        out[i, 0] = 0.0
+        for k in range(out.shape[1] - 1):
+            p0 = p[k] if k < n else 0.0
+            p1 = p[k + 1] if k + 1 < n else 0.0
             u1 = a11[i] * ui + a12[i] * vi + b10[i] * p0 + b11[i] * p1
-            v[i] = a21[i] * ui + a22[i] * vi + b20[i] * p0 + b21[i] * p1
-            u[i] = u1
+            vi = a21[i] * ui + a22[i] * vi + b20[i] * p0 + b21[i] * p1
+            ui = u1
             out[i, k + 1] = u1
 
 
@@ -129,7 +129,7 @@ def _dots_py(
     """out[r, j] = Σ_k G_{osc_r}[m_r - k] F[j, k]: oscillator osc_r's u at sample m_r under
     wavelet j (zero when the wavelet starts after m_r; G_i is zero from lg_i on)."""
     L = Gr.shape[1]
-    for r in range(osc.shape[0]):
+    for r in prange(osc.shape[0]):  # rows are independent: spread over the cores
         g = Gr[osc[r]]
         off = L - 1 - m[r]
         k0 = m[r] - lg[osc[r]] + 1
@@ -240,9 +240,12 @@ OPS_NUMPY = _Ops(_responses_np, _peaks_np, _wavelets_np, _dots_np, _lsq_np, _add
 if _numba is not None:
     _jit = _numba.njit(cache=True)
     OPS_NUMBA: _Ops | None = _Ops(
-        _jit(_responses_py), _jit(_peaks_py), _jit(_wavelets_py),
+        _numba.njit(cache=True, parallel=True)(_responses_py), _jit(_peaks_py),
+        _jit(_wavelets_py),
         # the two kernels whose sums are left to the compiler to order (SIMD dot products)
-        _numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz"})(_dots_py),
+        _numba.njit(cache=True, parallel=True, fastmath={"reassoc", "contract", "nsz"})(
+            _dots_py
+        ),
         _numba.njit(cache=True, fastmath={"reassoc", "contract", "nsz"})(_lsq_py),
         _jit(_add_py),
     )

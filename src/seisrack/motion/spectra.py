@@ -260,7 +260,20 @@ if HAVE_NUMBA:
     _hermite_peak_nb = _numba.njit(cache=True)(_hermite_peak)
     _exact_peak_nb = _numba.njit(cache=True)(_exact_peak)
     _free_peak_nb = _numba.njit(cache=True)(_free_peak)
-    _kernel_nb = _numba.njit(cache=True)(_kernel_py)
+    _kernel_1 = _numba.njit(cache=True)(_kernel_py)
+
+    @_numba.njit(cache=True, parallel=True)
+    def _kernel_nb(p, c, z, h, free, out):  # noqa: ANN001, ANN202
+        """_kernel_py on two halves of the oscillators, one per core (they are independent)."""
+        n_osc = c.shape[1]
+        if n_osc < 16:
+            _kernel_1(p, c, z, h, free, out)
+            return
+        half = n_osc // 2
+        for part in _numba.prange(2):
+            a = 0 if part == 0 else half
+            b = half if part == 0 else n_osc
+            _kernel_1(p, np.ascontiguousarray(c[:, a:b]), z, h, free, out[a:b])
 else:  # pragma: no cover
     _hermite_peak_nb = _hermite_peak
     _exact_peak_nb = _exact_peak
