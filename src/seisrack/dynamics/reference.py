@@ -260,16 +260,15 @@ def simulate_reference(
         vn = np.where(prob.on_ground, 0.0, v[prob.node] if n else 0.0)
         return un, vn
 
-    while t0 < duration - 1e-13:
-        # -- decide the contact state at t0 (acceleration level) ------------------------------
-        was = direction.copy()
-        zero_vel = direction == 0
-        trial = direction.copy()
-        released: list[int] = []
+    def release_overloaded(t: float, yv: np.ndarray, trial: np.ndarray) -> np.ndarray:
+        """Acceleration-level decision for the sliders at zero relative velocity in ``trial``:
+        release, one at a time, the one whose needed force exceeds mu_s N the most (sliders in
+        ``forced`` first), until the others can stay stuck. Updates and returns ``trial``."""
+        zero_vel = trial == 0
         for _ in range(m + 1):
-            lu = prob.factor(trial)
-            _, F = prob.accelerations(t0, y[:n], y[n : 2 * n], trial, lu)
-            N = prob.normal(t0)
+            lu_t = prob.factor(trial)
+            _, F = prob.accelerations(t, yv[:n], yv[n : 2 * n], trial, lu_t)
+            N = prob.normal(t)
             cand = np.flatnonzero(zero_vel & (trial == 0))
             if cand.size == 0:
                 break
@@ -280,8 +279,13 @@ def simulate_reference(
                 break
             k = int(cand[worst])
             trial[k] = -1 if F[k] > 0 else 1  # slides against the force it needed (Eq. 2)
-            released.append(k)
             forced.discard(k)
+        return trial
+
+    while t0 < duration - 1e-13:
+        # -- decide the contact state at t0 (acceleration level) ------------------------------
+        was = direction.copy()
+        trial = release_overloaded(t0, y, direction.copy())
         forced.clear()
         for k in range(m):
             if was[k] == 0 and trial[k] != 0:
@@ -387,23 +391,7 @@ def simulate_reference(
             new_dir[k] = 0
         # decide now for velocity events, to label stick vs reverse
         if fired_vel:
-            trial = new_dir.copy()
-            zero_vel = trial == 0
-            for _ in range(m + 1):
-                lu_t = prob.factor(trial)
-                _, F = prob.accelerations(t0, y[:n], y[n : 2 * n], trial, lu_t)
-                N = prob.normal(t0)
-                cand = np.flatnonzero(zero_vel & (trial == 0))
-                if cand.size == 0:
-                    break
-                ratio = np.abs(F[cand]) / np.maximum(mu_s[cand] * N[cand], 1e-300)
-                ratio = np.where(np.isin(cand, list(forced)), np.inf, ratio)
-                worst = int(np.argmax(ratio))
-                if ratio[worst] <= 1.0 + 1e-10:
-                    break
-                k = int(cand[worst])
-                trial[k] = -1 if F[k] > 0 else 1
-                forced.discard(k)
+            trial = release_overloaded(t0, y, new_dir.copy())
             for k in fired_vel:
                 if trial[k] == 0:
                     events.append(ReferenceEvent(t0, k, "stick"))
