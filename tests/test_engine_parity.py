@@ -4,7 +4,10 @@ tested for parity"; the pattern of pystrata, which runs the same validation unde
 Both backends execute the same source (``_kernel.py``); they may differ only by floating-point
 round-off (numba may fuse or reorder operations), so results must agree to 1e-12 relative on a
 short run with several slips, sticks and reversals, for classical (diagonal modal) and
-non-classical (dense modal) damping.
+non-classical (dense modal) damping. The exact-propagator kernel (``_kernel_exact.py``) is held
+to 1e-10: its constrained modes come from ``eigh``, which numba and numpy take from different
+LAPACK builds, and the accelerations recovered from equilibrium amplify that round-off by the
+stiffest ω².
 """
 
 from __future__ import annotations
@@ -38,11 +41,17 @@ def _problem(dense_damping: bool):
 FIELDS = ("q", "qd", "qdd", "slider_u", "slider_v", "sliding", "friction", "u", "v", "a")
 
 
-@pytest.mark.parametrize("dense_damping", [False, True], ids=["classical", "non-classical"])
-def test_numba_python_parity(dense_damping):
+@pytest.mark.parametrize(
+    ("dense_damping", "method"),
+    [(False, "newmark"), (True, "newmark"), (False, "exact")],
+    ids=["classical", "non-classical", "exact"],
+)
+def test_numba_python_parity(dense_damping, method):
     M, C, K, sl, kw = _problem(dense_damping)
-    fast = simulate(M, C, K, sl, backend="numba", **kw)
-    slow = simulate(M, C, K, sl, backend="python", **kw)
+    fast = simulate(M, C, K, sl, backend="numba", method=method, **kw)
+    slow = simulate(M, C, K, sl, backend="python", method=method, **kw)
+    assert fast.method == slow.method == method
+    rtol = 1e-12 if method == "newmark" else 1e-10
     assert (fast.backend, slow.backend) == ("numba", "python")
     assert fast.status == slow.status == "ok"
     kinds = [e.kind for e in slow.events]
@@ -50,13 +59,13 @@ def test_numba_python_parity(dense_damping):
     assert [(e.slider, e.kind) for e in fast.events] == [(e.slider, e.kind) for e in slow.events]
     t_f = np.array([e.time_s for e in fast.events])
     t_s = np.array([e.time_s for e in slow.events])
-    assert np.max(np.abs(t_f - t_s)) <= 1e-12 * N_STEPS * DT
+    assert np.max(np.abs(t_f - t_s)) <= rtol * N_STEPS * DT
     assert fast.n_substeps == slow.n_substeps
     assert np.array_equal(fast.stuck, slow.stuck)
     for name in FIELDS:
         a, b = getattr(fast, name), getattr(slow, name)
         scale = max(float(np.max(np.abs(b))), 1e-300)
-        assert np.max(np.abs(a - b)) <= 1e-12 * scale, name
+        assert np.max(np.abs(a - b)) <= rtol * scale, name
     for key, b in slow.energy.items():
         a = fast.energy[key]
-        assert np.max(np.abs(a - b)) <= 1e-12 * max(float(np.max(np.abs(b))), 1e-300), key
+        assert np.max(np.abs(a - b)) <= rtol * max(float(np.max(np.abs(b))), 1e-300), key

@@ -21,8 +21,9 @@ def warmup() -> dict[str, float]:
         return timings
     t0 = time.perf_counter()
     K = np.array([[2.0, -1.0], [-1.0, 1.0]])
-    simulate(np.eye(2), 0.01 * K, K, Sliders([0, 1], [1.0, 1.0], 0.3), dt=0.01,
-             ground_accel=np.sin(np.arange(60) * 0.2), backend="numba")
+    for method in ("exact", "newmark"):
+        simulate(np.eye(2), 0.01 * K, K, Sliders([0, 1], [1.0, 1.0], 0.3), dt=0.01,
+                 ground_accel=np.sin(np.arange(60) * 0.2), backend="numba", method=method)
     timings["stick-slip engine"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     from seisrack.motion import response_spectrum

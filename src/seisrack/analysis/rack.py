@@ -247,6 +247,7 @@ def run_rack(
     rigid_companion: bool = True,
     progress: Callable[[int], None] | None = None,
     throw: bool = True,
+    method: str = "auto",
 ) -> RackResponse:
     """Time history of ``model`` under the horizontal ground acceleration ``record``.
 
@@ -257,6 +258,8 @@ def run_rack(
     rigid_companion: also run the rack with rigidly held pallets (for the simplified check).
     progress: called with the number of analysis steps just completed, an increment (as
         ``tqdm.update`` expects), after each chunk of steps of the main run.
+    method: time integration of :func:`seisrack.dynamics.simulate` ("auto", "exact" or
+        "newmark").
     """
     if not isinstance(record, Record):
         raise InputError("record", type(record).__name__, "a seisrack.motion.Record")
@@ -294,7 +297,7 @@ def run_rack(
     hist = simulate(
         model.M, model.C, model.K, sliders, dt=h, ground_accel=ag, influence=model.r_x,
         vertical_accel=av, vertical_influence=None if av is None else model.r_y, g=model.g,
-        backend=backend, throw=throw, progress=progress,
+        backend=backend, throw=throw, progress=progress, method=method,
     )
     rigid_peak = None
     if rigid_companion and model.n_pallets:
@@ -303,7 +306,7 @@ def run_rack(
             Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU),
             dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
             vertical_influence=None if av is None else model.r_y, g=model.g, backend=backend,
-            throw=throw, track_energy=False,
+            throw=throw, track_energy=False, method=method,
         )
         rigid_peak = np.array([
             np.max(np.abs(rigid.dof_response(d, "a").mean(axis=1) + ag)) for d in model.level_dofs

@@ -1,9 +1,11 @@
-"""numba-compiled build of ``_kernel.py`` (the same source, executed with ``_JIT = njit``)."""
+"""numba-compiled build of ``_kernel.py`` and ``_kernel_exact.py`` (the same sources, executed
+with ``_JIT = njit`` in one namespace)."""
 
 from pathlib import Path
 
 import numba
 
 _JIT = numba.njit(cache=True)
-_SRC = Path(__file__).with_name("_kernel.py")
-exec(compile(_SRC.read_text(encoding="utf-8"), str(_SRC), "exec"))  # noqa: S102
+for _name in ("_kernel.py", "_kernel_exact.py"):
+    _SRC = Path(__file__).with_name(_name)
+    exec(compile(_SRC.read_text(encoding="utf-8"), str(_SRC), "exec"))  # noqa: S102

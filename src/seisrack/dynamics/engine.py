@@ -95,6 +95,7 @@ def simulate(
     throw: bool = True,
     progress: Callable[[int], None] | None = None,
     chunk_steps: int | None = None,
+    method: str = "auto",
 ) -> TimeHistory:
     """Time history of a linear structure carrying masses that may stick or slide.
 
@@ -116,6 +117,10 @@ def simulate(
     progress : called with the number of steps just completed, after each chunk of
         ``chunk_steps`` steps (default 2000 when ``progress`` is given); chunking does not change
         the result, the contact state carries over exactly.
+    method : "exact" propagates every contact configuration with its own closed-form modal
+        solution (exact between events for loads linear inside a step; needs classical damping
+        in every configuration: no damping, C ∝ K, or no slider on the structure), "newmark"
+        uses average-acceleration Newmark, "auto" (default) takes "exact" when it applies.
     """
     M = _square("M", M, None)
     n = M.shape[0]
@@ -182,7 +187,13 @@ def simulate(
 
     if chunk_steps is not None and (int(chunk_steps) != chunk_steps or chunk_steps < 1):
         raise InputError("chunk_steps", chunk_steps, "an integer >= 1")
-    kern = get_kernel(backend)
+    if method not in ("auto", "exact", "newmark"):
+        raise InputError("method", method, '"auto", "exact" or "newmark"')
+    why_not = _exact_unsupported(w2, cd, diag, sliders.dof)
+    if method == "exact" and why_not:
+        raise InputError("method", method, f'"newmark" or "auto" here: {why_not}')
+    use_exact = method != "newmark" and not why_not
+    kern = get_kernel(backend, "exact" if use_exact else "newmark")
     used = "numba" if kern.__name__.endswith("_numba") else "python"
     out_q = np.empty((n_t, n))
     out_qd = np.empty((n_t, n))
@@ -205,22 +216,41 @@ def simulate(
     sig_state = np.ones(m)
     e_state = np.zeros(3)
     chunk = n_steps if chunk_steps is None and progress is None else int(chunk_steps or 2000)
-    status, n_ev, n_sub = 0, 0, 0
+    status, n_ev, n_sub, n_cfg = 0, 0, 0, 0
+    if use_exact:
+        a1 = _stiffness_proportional(w2, cd)
+        rv_in = None if vertical_influence is None else np.asarray(vertical_influence, float)
+        pat, series = _load_patterns(n, ag, gamma, F, phi, av, rv_in, M, pext)
+        cache_size = int(np.clip(2.0e8 / (8.0 * (3 * n * n + n * m + 16 * n + 1)), 4, 64))
     start = 0
     while start < n_steps:
         stop = min(start + chunk, n_steps)
         rows = slice(start, stop + 1)
         qs = q0 if start == 0 else out_q[start].copy()
         qds = qd0 if start == 0 else out_qd[start].copy()
-        st, ne, ns = kern.run_kernel(
-            w2c, cd, Cq, diag, P, sliders.mass, sliders.mu_static, sliders.mu_dynamic,
-            float(dt), ag[rows], pext[rows], N[rows], qs, qds,
-            start > 0, w_state, wd_state, stuck_state, sig_state, e_state, start * float(dt),
-            bool(track_energy), max(int(max_events) - n_ev, 0), _MAX_SUBSTEPS,
-            out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows], out_wd[rows],
-            out_lam[rows], out_stuck[rows], out_energy[rows],
-            ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
-        )
+        if use_exact:
+            st, ne, ns, nc = kern.run_kernel_exact(
+                w2c, cd, a1, not bool(np.any(sliders.dof >= 0)), P, sliders.mass,
+                sliders.mu_static, sliders.mu_dynamic, float(dt), ag[rows], pext[rows], pat,
+                series[rows], N[rows], qs, qds,
+                start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                start * float(dt), bool(track_energy), max(int(max_events) - n_ev, 0),
+                _MAX_SUBSTEPS, cache_size,
+                out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows], out_wd[rows],
+                out_lam[rows], out_stuck[rows], out_energy[rows],
+                ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
+            )
+            n_cfg += int(nc)
+        else:
+            st, ne, ns = kern.run_kernel(
+                w2c, cd, Cq, diag, P, sliders.mass, sliders.mu_static, sliders.mu_dynamic,
+                float(dt), ag[rows], pext[rows], N[rows], qs, qds,
+                start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                start * float(dt), bool(track_energy), max(int(max_events) - n_ev, 0),
+                _MAX_SUBSTEPS, out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows],
+                out_wd[rows], out_lam[rows], out_stuck[rows], out_energy[rows],
+                ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
+            )
         n_ev += int(ne)
         n_sub += int(ns)
         status = int(st)
@@ -267,4 +297,46 @@ def simulate(
         status=status_text,
         backend=used,
         n_substeps=int(n_sub),
+        method="exact" if use_exact else "newmark",
+        n_configurations=int(n_cfg),
     )
+
+
+def _stiffness_proportional(w2: np.ndarray, cd: np.ndarray) -> float:
+    """a1 with cd = a1 w2 (least squares over the modes)."""
+    den = float(np.dot(w2, w2))
+    return float(np.dot(cd, w2) / den) if den > 0.0 else 0.0
+
+
+def _exact_unsupported(w2: np.ndarray, cd: np.ndarray, diag: bool, dof: np.ndarray) -> str:
+    """Why the exact propagator does not apply here ('' when it does)."""
+    if not diag:
+        return "the damping is not classical (Φᵀ C Φ is not diagonal)"
+    if w2.size and float(np.min(w2)) <= 1e-12 * float(np.max(w2)):
+        return "the structure has a zero-frequency (rigid-body) mode"
+    if np.any(dof >= 0):
+        a1 = _stiffness_proportional(w2, cd)
+        scale = max(float(np.max(np.abs(cd))), 1e-300)
+        if float(np.max(np.abs(cd - a1 * w2))) > 1e-8 * scale:
+            return (
+                "damping with a mass-proportional or modal part is not classical once sliders "
+                "stick to the structure (exact needs C = 0 or C ∝ K)"
+            )
+    return ""
+
+
+def _load_patterns(n, ag, gamma, F, phi, av, rv, M, pext):  # noqa: ANN001, ANN202, N803
+    """Split the modal load as ``pext = series @ pat`` with few patterns when possible."""
+    pats = [-gamma]
+    cols = [ag]
+    if F is not None:
+        loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
+        if loaded.size > max(n // 2, 1):
+            return np.eye(n), np.ascontiguousarray(pext)
+        for d in loaded:
+            pats.append(phi[d, :])
+            cols.append(F[:, d])
+    if av is not None and rv is not None:
+        pats.append(-(phi.T @ (M @ rv)))
+        cols.append(av)
+    return np.ascontiguousarray(np.array(pats)), np.ascontiguousarray(np.column_stack(cols))

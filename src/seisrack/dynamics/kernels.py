@@ -21,12 +21,17 @@ def numba_available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
-def get_kernel(backend: str = "auto") -> ModuleType:
-    """Return the kernel module for ``backend`` in {"auto", "numba", "python"}."""
+def get_kernel(backend: str = "auto", method: str = "newmark") -> ModuleType:
+    """Return the kernel module for ``backend`` in {"auto", "numba", "python"}.
+
+    The numba module holds both ``run_kernel`` (Newmark) and ``run_kernel_exact``; the Python
+    twins are ``_kernel`` and ``_kernel_exact``.
+    """
     if backend == "auto":
         backend = "numba" if numba_available() else "python"
     if backend == "python":
-        return importlib.import_module("seisrack.dynamics._kernel")
+        name = "_kernel_exact" if method == "exact" else "_kernel"
+        return importlib.import_module(f"seisrack.dynamics.{name}")
     if backend == "numba":
         if not numba_available():
             raise InputError(

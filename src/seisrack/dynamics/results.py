@@ -50,6 +50,8 @@ class TimeHistory:
     status: str = "ok"
     backend: str = "python"
     n_substeps: int = 0
+    method: str = "newmark"
+    n_configurations: int = 0
 
     @cached_property
     def u(self) -> np.ndarray:

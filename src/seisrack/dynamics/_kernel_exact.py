@@ -1,0 +1,764 @@
+"""Exact-propagator stick–slip kernel (source shared by the numba and pure-Python backends).
+
+Loaded after ``_kernel.py`` in the same namespace (see :mod:`seisrack.dynamics.kernels`), so it
+reuses ``_solve``, ``_mv``, ``_interp``, ``_event_values`` and ``_consistent`` from there.
+
+Between two contact events the system is linear and time-invariant: the structure plus the
+masses of the sliders that are stuck on it (they move with their support node), loaded by
+excitations that are linear in time inside a step and by the known friction forces of the
+sliding sliders. For each contact configuration the kernel computes the modes of that
+constrained system once (generalised symmetric eigenproblem of ``diag(omega²)`` against
+``I + P_S^T diag(m_S) P_S`` in the structure's modal coordinates) and propagates each mode in
+closed form over the step (homogeneous 2x2 exponential plus the particular solution of a
+linear-in-time load). This is exact for classical damping in every configuration, which the
+engine checks before choosing this kernel (no damping, stiffness-proportional damping, or no
+slider resting on the structure). The only discretisation errors left are the linear
+interpolation of the excitation between samples and the tolerance of the event location.
+See ``docs/theory/stick_slip_engine.md`` §9.
+"""
+
+# ruff: noqa: N803, N806  (matrix names follow the equations)
+
+import numpy as np
+
+try:  # names injected by the loader when executed after ``_kernel.py``
+    _consistent  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._kernel import (  # noqa: F401
+        _JIT,
+        KIND_REVERSE,
+        KIND_SLIP,
+        KIND_STICK,
+        STATUS_EVENT_OVERFLOW,
+        STATUS_NONFINITE,
+        STATUS_OK,
+        STATUS_SUBSTEP_LIMIT,
+        _consistent,
+        _event_values,
+        _interp,
+        _mv,
+    )
+
+#: Gauss–Legendre 3-point nodes and weights on [0, 1] (energy quadrature)
+_GL_X = np.array([0.5 - 0.1 * np.sqrt(15.0), 0.5, 0.5 + 0.1 * np.sqrt(15.0)])
+_GL_W = np.array([5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0])
+
+
+@_JIT
+def _mode_matrix(nu2, c, h, E):
+    """Homogeneous propagator of y'' + c y' + nu2 y = 0 over h: E = (E00, E01, E10, E11).
+
+    One formula for every damping regime: with a = c/2 and b² = nu2 - a², the solution is
+    e^{-a t} (C(t) y0 + S(t) (y0' + a y0)) with C = cos/cosh/1 and S = sin(bt)/b, sinh/b or t.
+    Overdamped stiff modes are evaluated as sums of decaying exponentials (no overflow).
+    """
+    a = 0.5 * c
+    b2 = nu2 - a * a
+    x = b2 * h * h
+    if abs(x) < 1e-3:
+        # series in b² h² (cos / cosh and sin/b / sinh/b share it)
+        eC = 1.0 - x / 2.0 + x * x / 24.0 - x * x * x / 720.0
+        eS = h * (1.0 - x / 6.0 + x * x / 120.0 - x * x * x / 5040.0)
+        ea = np.exp(-a * h)
+        eC *= ea
+        eS *= ea
+    elif b2 > 0.0:
+        b = np.sqrt(b2)
+        ea = np.exp(-a * h)
+        eC = ea * np.cos(b * h)
+        eS = ea * np.sin(b * h) / b
+    else:
+        b = np.sqrt(-b2)
+        # a - b >= 0 computed without cancellation: (a - b) = nu2 / (a + b)
+        slow = nu2 / (a + b)
+        e1 = np.exp(-slow * h)
+        e2 = np.exp(-(a + b) * h)
+        eC = 0.5 * (e1 + e2)
+        eS = 0.5 * (e1 - e2) / b
+    E[0] = eC + a * eS
+    E[1] = eS
+    E[2] = -nu2 * eS
+    E[3] = eC - a * eS
+
+
+@_JIT
+def _mode_matrices(nu2, cc, h, E):
+    for k in range(nu2.shape[0]):
+        _mode_matrix(nu2[k], cc[k], h, E[k])
+
+
+@_JIT
+def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
+    """Exact modal step: loads g linear from g0 to g1 over h; E from ``_mode_matrices(h)``."""
+    for k in range(nu2.shape[0]):
+        s = (g1[k] - g0[k]) / h
+        B = s / nu2[k]
+        A = (g0[k] - cc[k] * B) / nu2[k]
+        y = eta0[k] - A
+        yd = etad0[k] - B
+        eta1[k] = A + B * h + E[k, 0] * y + E[k, 1] * yd
+        etad1[k] = B + E[k, 2] * y + E[k, 3] * yd
+
+
+@_JIT
+def _build_config(slot, key, w2, cd, a1, fixed, P, mass, pat, dt,
+                  c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E):
+    """Modes of the structure with the sliders of ``key`` stuck on it, and derived operators."""
+    n = w2.shape[0]
+    m = P.shape[0]
+    Ms = np.eye(n)
+    any_stuck = False
+    for j in range(m):
+        if key[j]:
+            any_stuck = True
+            for i in range(n):
+                pji = mass[j] * P[j, i]
+                if pji != 0.0:
+                    for k in range(n):
+                        Ms[i, k] += pji * P[j, k]
+    if fixed or not any_stuck:
+        psi = np.eye(n)
+        nu2 = w2.copy()
+        cc = cd.copy()
+    else:
+        L = np.linalg.cholesky(Ms)
+        Linv = np.linalg.inv(L)
+        A = Linv @ np.diag(w2) @ Linv.T
+        A = 0.5 * (A + A.T)
+        nu2, Y = np.linalg.eigh(A)
+        psi = Linv.T @ Y
+        cc = a1 * nu2
+    scale = max(np.max(np.abs(nu2)), 1e-300)
+    for k in range(n):
+        if nu2[k] < 1e-14 * scale:
+            nu2[k] = 1e-14 * scale
+    c_psi[slot] = psi
+    c_psitm[slot] = psi.T @ Ms
+    c_nu2[slot] = nu2
+    c_cc[slot] = cc
+    c_R[slot] = P @ psi
+    c_gpat[slot] = psi.T @ pat.T
+    c_gsl[slot] = psi.T @ P.T
+    _mode_matrices(nu2, cc, dt, c_E[slot])
+
+
+@_JIT
+def _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P, mass, pat,
+                 dt, c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E):
+    """Slot of the configuration ``key`` in the cache (built on a miss; LRU eviction)."""
+    cap = cfg_key.shape[0]
+    m = key.shape[0]
+    for s in range(cap):
+        if cfg_valid[s]:
+            same = True
+            for j in range(m):
+                if cfg_key[s, j] != key[j]:
+                    same = False
+                    break
+            if same:
+                cfg_stamp[s] = stamp
+                return s, False
+    slot = 0
+    oldest = cfg_stamp[0] if cfg_valid[0] else -1
+    for s in range(cap):
+        if not cfg_valid[s]:
+            slot = s
+            break
+        if cfg_stamp[s] < oldest:
+            oldest = cfg_stamp[s]
+            slot = s
+    _build_config(slot, key, w2, cd, a1, fixed, P, mass, pat, dt,
+                  c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E)
+    for j in range(m):
+        cfg_key[slot, j] = key[j]
+    cfg_valid[slot] = True
+    cfg_stamp[slot] = stamp
+    return slot, True
+
+
+@_JIT
+def _loads(gpat, gsl, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, out):
+    """Constrained modal load at one instant: Ψᵀ(p - P_Sᵀ m_S a_g - P_Fᵀ λ_F)."""
+    n = out.shape[0]
+    npat = series_t.shape[0]
+    m = mass.shape[0]
+    for k in range(n):
+        acc = 0.0
+        for c in range(npat):
+            acc += gpat[k, c] * series_t[c]
+        out[k] = acc
+    for j in range(m):
+        if not on_struct[j]:
+            continue
+        if stuck[j]:
+            f = -mass[j] * ag_t
+        else:
+            f = mud[j] * N_t[j] * sig[j]  # -λ_j with λ_j = -mu_d N σ
+        if f != 0.0:
+            for k in range(n):
+                out[k] += gsl[k, j] * f
+
+
+@_JIT
+def _trial_exact(h, Eh, psi, nu2, cc, R, gpat, gsl, mass, mud, on_struct, stuck, sig,
+                 eta0, etad0, w0, wd0, ser0, ser1, ag0, ag1, N0, N1, g0, g1,
+                 eta1, etad1, w1, wd1, lam1, s1, etadd):
+    """Exact step of length h in a fixed contact state (E = propagator for h)."""
+    n = nu2.shape[0]
+    m = mass.shape[0]
+    _loads(gpat, gsl, ser0, ag0, N0, mass, mud, stuck, sig, on_struct, g0)
+    _loads(gpat, gsl, ser1, ag1, N1, mass, mud, stuck, sig, on_struct, g1)
+    _propagate(nu2, cc, Eh, eta0, etad0, g0, g1, h, eta1, etad1)
+    for k in range(n):
+        etadd[k] = g1[k] - cc[k] * etad1[k] - nu2[k] * eta1[k]
+    for j in range(m):
+        if stuck[j]:
+            d0 = 0.0
+            d1 = 0.0
+            v1 = 0.0
+            a1_ = 0.0
+            for k in range(n):
+                r = R[j, k]
+                d0 += r * eta0[k]
+                d1 += r * eta1[k]
+                v1 += r * etad1[k]
+                a1_ += r * etadd[k]
+            w1[j] = w0[j] + (d1 - d0)
+            wd1[j] = v1
+            lam1[j] = mass[j] * (a1_ + ag1)
+            s1[j] = 0.0
+        else:
+            lam0 = -mud[j] * N0[j] * sig[j]
+            lam1[j] = -mud[j] * N1[j] * sig[j]
+            a0 = -ag0 + lam0 / mass[j]
+            a1_ = -ag1 + lam1[j] / mass[j]
+            wd1[j] = wd0[j] + 0.5 * h * (a0 + a1_)
+            w1[j] = w0[j] + h * wd0[j] + h * h * (2.0 * a0 + a1_) / 6.0
+            v1 = 0.0
+            for k in range(n):
+                v1 += R[j, k] * etad1[k]
+            s1[j] = wd1[j] - v1
+
+
+@_JIT
+def _to_physical(psi, eta, etad, q, qd):
+    n = psi.shape[0]
+    for i in range(n):
+        a = 0.0
+        b = 0.0
+        for k in range(n):
+            a += psi[i, k] * eta[k]
+            b += psi[i, k] * etad[k]
+        q[i] = a
+        qd[i] = b
+
+
+@_JIT
+def _to_modal(psitm, q, qd, eta, etad):
+    _to_physical(psitm, q, qd, eta, etad)
+
+
+@_JIT
+def _equilibrium_qdd(w2, cd, P, pext_t, q, qd, lam, qdd):
+    n = w2.shape[0]
+    m = P.shape[0]
+    for i in range(n):
+        acc = pext_t[i] - cd[i] * qd[i] - w2[i] * q[i]
+        for j in range(m):
+            acc -= P[j, i] * lam[j]
+        qdd[i] = acc
+
+
+@_JIT
+def _energy_substep(h, Eh, nu2, cc, R, eta0, etad0, g0, g1, mass, mud, on_struct, stuck, sig,
+                    w0, wd0, ag0, ag1, N0, N1, out):
+    """Input, damping and friction work over a sub-step, in closed form.
+
+    Per mode (η̈ + c η̇ + ν² η = g0 + s τ, particular part A + B τ, homogeneous part y):
+    ∫ (l0 + l1 τ) η̇ dτ = l0 Δη + l1 (h η(h) - ∫η), with ∫y = -(Δẏ + c Δy)/ν² from the mode
+    equation, and c ∫ η̇² = c B² h + 2 c B Δy + x0ᵀ (c W) x0, where W is the 2x2 Gramian
+    ∫ e^{Jᵀτ} e2 e2ᵀ e^{Jτ} dτ solved from its Lyapunov equation (written for c W, so that an
+    undamped mode gives 0 without dividing by c). Slider terms are polynomials in τ
+    (3-point Gauss–Legendre is exact for them). Powers: gᵀη̇ is the structural input (it
+    includes the stuck sliders' inertia); the sliding forces inside g are moved to friction.
+    """
+    n = nu2.shape[0]
+    m = mass.shape[0]
+    e_in = 0.0
+    e_d = 0.0
+    e_f = 0.0
+    # per-slider sliding-force slopes on the structure: λ_j(τ) = lam0 + lam_s τ
+    for k in range(n):
+        c = cc[k]
+        w = nu2[k]
+        s = (g1[k] - g0[k]) / h
+        B = s / w
+        A = (g0[k] - c * B) / w
+        y0 = eta0[k] - A
+        yd0 = etad0[k] - B
+        y1 = Eh[k, 0] * y0 + Eh[k, 1] * yd0
+        yd1 = Eh[k, 2] * y0 + Eh[k, 3] * yd0
+        eta_h = A + B * h + y1
+        d_eta = eta_h - eta0[k]
+        int_y = -((yd1 - yd0) + c * (y1 - y0)) / w
+        int_eta = A * h + 0.5 * B * h * h + int_y
+        mom = h * eta_h - int_eta  # ∫ τ η̇ dτ
+        e_in += g0[k] * d_eta + s * mom
+        # damping: c ∫ η̇² = c B² h + 2 c B (y1 - y0) + x0ᵀ (cW) x0
+        if c != 0.0:
+            R11 = Eh[k, 2] * Eh[k, 2]
+            R12 = Eh[k, 2] * Eh[k, 3]
+            R22 = Eh[k, 3] * Eh[k, 3] - 1.0
+            w12 = -R11 / (2.0 * w)
+            cw22 = w12 - 0.5 * R22
+            cw12 = c * w12
+            cw11 = c * R12 + w * cw22 + c * c * w12
+            e_d += (c * B * B * h + 2.0 * c * B * (y1 - y0)
+                    + cw11 * y0 * y0 + 2.0 * cw12 * y0 * yd0 + cw22 * yd0 * yd0)
+        # sliding forces on the structure: their power leaves the input, enters friction
+        for j in range(m):
+            if on_struct[j] and not stuck[j]:
+                r = R[j, k]
+                if r != 0.0:
+                    l0 = -mud[j] * N0[j] * sig[j]
+                    ls = (-mud[j] * N1[j] * sig[j] - l0) / h
+                    work = r * (l0 * d_eta + ls * mom)  # ∫ λ_j v_support dτ
+                    e_in += work
+                    e_f += work
+    for j in range(m):
+        if stuck[j]:
+            continue  # stuck on the structure: inside g; stuck on the ground: no motion
+        l0 = -mud[j] * N0[j] * sig[j]
+        l1 = -mud[j] * N1[j] * sig[j]
+        a0 = -ag0 + l0 / mass[j]
+        for p in range(3):
+            x = _GL_X[p]
+            tau = x * h
+            wgt = _GL_W[p] * h
+            ag_t = ag0 + x * (ag1 - ag0)
+            lam_t = l0 + x * (l1 - l0)
+            wd_t = wd0[j] + 0.5 * tau * (a0 + (-ag_t + lam_t / mass[j]))
+            e_in -= wgt * mass[j] * ag_t * wd_t
+            e_f -= wgt * lam_t * wd_t
+    out[0] = e_in
+    out[1] = e_d
+    out[2] = e_f
+
+
+@_JIT
+def _cfg_key(stuck, on_struct, key):
+    for j in range(stuck.shape[0]):
+        key[j] = stuck[j] and on_struct[j]
+
+
+@_JIT
+def run_kernel_exact(
+    w2, cd, a1, fixed, P, mass, mus, mud, dt, ag, pext, pat, series, N, q_init, qd_init,
+    resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
+    track_energy, max_events, max_substeps, cache_size,
+    out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy,
+    ev_time, ev_slider, ev_kind,
+):
+    """Integrate ``n_steps = ag.shape[0] - 1`` steps with exact modal propagators.
+
+    Same interface and outputs as ``run_kernel`` (Newmark) except: ``a1`` (C = a1 K) or
+    ``fixed`` (no slider on the structure: the basis never changes), the load split
+    ``pext = series @ pat`` ((n_t, npat) time series of (npat, n) modal load patterns; ``pext``
+    itself is used for the accelerations), and ``cache_size`` (contact configurations kept).
+    Returns (status, n_events, n_substeps, n_configs_built).
+    """
+    n = w2.shape[0]
+    m = mass.shape[0]
+    n_t = ag.shape[0]
+    npat = pat.shape[0]
+    on_struct = np.zeros(m, dtype=np.bool_)
+    for j in range(m):
+        for i in range(n):
+            if P[j, i] != 0.0:
+                on_struct[j] = True
+    B = np.zeros((m, m))
+    for a in range(m):
+        for b in range(m):
+            acc = 0.0
+            for i in range(n):
+                acc += P[a, i] * P[b, i]
+            B[a, b] = acc
+        B[a, a] += 1.0 / mass[a]
+    Cq = np.zeros((1, 1))
+    # configuration cache
+    cap = max(cache_size, 1)
+    cfg_key = np.zeros((cap, m), dtype=np.bool_)
+    cfg_valid = np.zeros(cap, dtype=np.bool_)
+    cfg_stamp = np.zeros(cap, dtype=np.int64)
+    c_psi = np.zeros((cap, n, n))
+    c_psitm = np.zeros((cap, n, n))
+    c_nu2 = np.zeros((cap, n))
+    c_cc = np.zeros((cap, n))
+    c_R = np.zeros((cap, m, n))
+    c_gpat = np.zeros((cap, n, npat))
+    c_gsl = np.zeros((cap, n, m))
+    c_E = np.zeros((cap, n, 4))
+    n_built = 0
+    stamp = 0
+    key = np.zeros(m, dtype=np.bool_)
+    # state
+    q = q_init.copy()
+    qd = qd_init.copy()
+    qdd = np.zeros(n)
+    wdd = np.zeros(m)
+    lam = np.zeros(m)
+    forced = np.zeros(m, dtype=np.bool_)
+    if resume:
+        w = w_state.copy()
+        wd = wd_state.copy()
+        stuck = stuck_state.copy()
+        sig = sig_state.copy()
+        E_in = e_state[0]
+        E_damp = e_state[1]
+        E_fric = e_state[2]
+    else:
+        w = np.empty(m)
+        wd = np.empty(m)
+        _mv(P, q, w)
+        _mv(P, qd, wd)
+        stuck = np.ones(m, dtype=np.bool_)
+        sig = np.ones(m)
+        E_in = 0.0
+        E_damp = 0.0
+        E_fric = 0.0
+    cand = stuck.copy()
+    _consistent(w2, cd, Cq, True, P, B, mass, mus, mud, q, qd, ag[0], pext[0], N[0],
+                stuck, sig, cand, forced, qdd, wdd, lam)
+    n_ev = 0
+    status = STATUS_OK
+    for j in range(m):
+        if cand[j] and not stuck[j]:
+            if n_ev < max_events:
+                ev_time[n_ev] = t_offset
+                ev_slider[n_ev] = j
+                ev_kind[n_ev] = KIND_SLIP
+            n_ev += 1
+    _cfg_key(stuck, on_struct, key)
+    slot, built = _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P,
+                               mass, pat, dt, c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl,
+                               c_E)
+    n_built += 1
+    eta = np.empty(n)
+    etad = np.empty(n)
+    _to_modal(c_psitm[slot], q, qd, eta, etad)
+    # buffers
+    eta1 = np.empty(n)
+    etad1 = np.empty(n)
+    etadd = np.empty(n)
+    w1 = np.empty(m)
+    wd1 = np.empty(m)
+    lam1 = np.empty(m)
+    s1 = np.empty(m)
+    s = np.zeros(m)
+    g0 = np.empty(n)
+    g1 = np.empty(n)
+    etab = np.empty(n)
+    etadb = np.empty(n)
+    wb = np.empty(m)
+    wdb = np.empty(m)
+    lamb = np.empty(m)
+    sb = np.empty(m)
+    gb = np.empty(n)
+    e_lo = np.empty(m)
+    e_hi = np.empty(m)
+    e_try = np.empty(m)
+    tolF = np.empty(m)
+    Esub = np.empty((n, 4))
+    ser0 = np.empty(npat)
+    ser1 = np.empty(npat)
+    sere = np.empty(npat)
+    pe_t = np.empty(n)
+    ework = np.zeros(3)
+    vn = np.empty(m)
+    N0 = np.empty(m)
+    N_e = np.empty(m)
+    n_sub_total = 0
+    _mv(P, qd, vn)
+    for j in range(m):
+        s[j] = wd[j] - vn[j]
+
+    out_q[0, :] = q
+    out_qd[0, :] = qd
+    out_qdd[0, :] = qdd
+    out_w[0, :] = w
+    out_wd[0, :] = wd
+    out_lam[0, :] = lam
+    for j in range(m):
+        out_stuck[0, j] = stuck[j]
+    if track_energy:
+        ke = 0.5 * np.dot(qd, qd)
+        for j in range(m):
+            ke += 0.5 * mass[j] * wd[j] * wd[j]
+        se = 0.0
+        for i in range(n):
+            se += 0.5 * w2[i] * q[i] * q[i]
+        out_energy[0, 0] = E_in
+        out_energy[0, 1] = ke
+        out_energy[0, 2] = se
+        out_energy[0, 3] = E_damp
+        out_energy[0, 4] = E_fric
+    for step in range(n_t - 1):
+        tau = 0.0
+        n_sub = 0
+        while True:
+            n_sub += 1
+            if n_sub > max_substeps:
+                status = STATUS_SUBSTEP_LIMIT
+                break
+            full = tau == 0.0
+            hrem = (1.0 - tau) * dt
+            nu2 = c_nu2[slot]
+            cc = c_cc[slot]
+            R = c_R[slot]
+            gpat = c_gpat[slot]
+            gsl = c_gsl[slot]
+            for c in range(npat):
+                ser0[c] = _interp(series[step, c], series[step + 1, c], tau)
+                ser1[c] = series[step + 1, c]
+            ag0 = _interp(ag[step], ag[step + 1], tau)
+            ag1 = ag[step + 1]
+            for j in range(m):
+                N0[j] = _interp(N[step, j], N[step + 1, j], tau)
+            if full:
+                Eh = c_E[slot]
+            else:
+                _mode_matrices(nu2, cc, hrem, Esub)
+                Eh = Esub
+            _trial_exact(hrem, Eh, c_psi[slot], nu2, cc, R, gpat, gsl, mass, mud, on_struct,
+                         stuck, sig, eta, etad, w, wd, ser0, ser1, ag0, ag1, N0, N[step + 1],
+                         g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd)
+            any_ev = False
+            for j in range(m):
+                n1 = N[step + 1, j]
+                if stuck[j]:
+                    tolF[j] = 1e-11 * mus[j] * max(N[step, j], n1) + 1e-300
+                    e_hi[j] = abs(lam1[j]) - mus[j] * n1
+                else:
+                    vscale = abs(wd1[j]) + abs(wd1[j] - s1[j]) + mud[j] * n1 / mass[j] * dt
+                    tolF[j] = 1e-9 * vscale
+                    e_hi[j] = -sig[j] * s1[j]
+                if e_hi[j] > tolF[j]:
+                    any_ev = True
+            theta_hi = 1.0
+            frac_hi = 1.0
+            if any_ev:
+                _event_values(stuck, sig, lam, N0, s, mus, e_lo)
+                theta_lo = 0.0
+                streak = 0
+                side = 0
+                sc_lo = 1.0
+                sc_hi = 1.0
+                etab[:] = eta1
+                etadb[:] = etad1
+                wb[:] = w1
+                wdb[:] = wd1
+                lamb[:] = lam1
+                sb[:] = s1
+                gb[:] = g1
+                for _it in range(100):
+                    th = theta_hi
+                    jmin = -1
+                    for j in range(m):
+                        if e_hi[j] > tolF[j]:
+                            elo = min(e_lo[j] - tolF[j], 0.0) * sc_lo
+                            den = (e_hi[j] - tolF[j]) * sc_hi - elo
+                            frac = -elo / den if den > 0.0 else 0.0
+                            tj = theta_lo + frac * (theta_hi - theta_lo)
+                            if tj < th or jmin < 0:
+                                th = tj
+                                jmin = j
+                    if jmin < 0:
+                        break
+                    if stuck[jmin]:
+                        conv = e_hi[jmin] <= 1e-10 * mus[jmin] * N[step + 1, jmin] + tolF[jmin]
+                    else:
+                        conv = e_hi[jmin] <= 2.0 * tolF[jmin]
+                    span = theta_hi - theta_lo
+                    if conv or span * hrem <= 1e-12 * dt:
+                        break
+                    if streak >= 6:
+                        th = theta_lo + 0.5 * span
+                        streak = 0
+                    if th <= theta_lo + 1e-6 * span:
+                        th = theta_lo + 1e-6 * span
+                    if th >= theta_hi - 1e-6 * span:
+                        th = theta_hi - 1e-6 * span
+                    hsub = th * hrem
+                    frac_end = tau + th * (1.0 - tau)
+                    for c in range(npat):
+                        sere[c] = _interp(series[step, c], series[step + 1, c], frac_end)
+                    ag_e = _interp(ag[step], ag[step + 1], frac_end)
+                    for j in range(m):
+                        N_e[j] = _interp(N[step, j], N[step + 1, j], frac_end)
+                    _mode_matrices(nu2, cc, hsub, Esub)
+                    _trial_exact(hsub, Esub, c_psi[slot], nu2, cc, R, gpat, gsl, mass, mud,
+                                 on_struct, stuck, sig, eta, etad, w, wd, ser0, sere, ag0, ag_e,
+                                 N0, N_e, g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd)
+                    _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
+                    viol_try = False
+                    for j in range(m):
+                        if e_try[j] > tolF[j]:
+                            viol_try = True
+                    if viol_try:
+                        theta_hi = th
+                        e_hi[:] = e_try
+                        etab[:] = eta1
+                        etadb[:] = etad1
+                        wb[:] = w1
+                        wdb[:] = wd1
+                        lamb[:] = lam1
+                        sb[:] = s1
+                        gb[:] = g1
+                        streak = streak + 1 if side == 1 else 1
+                        if side == 1:
+                            sc_lo *= 0.5
+                        sc_hi = 1.0
+                        side = 1
+                    else:
+                        theta_lo = th
+                        e_lo[:] = e_try
+                        streak = streak + 1 if side == -1 else 1
+                        if side == -1:
+                            sc_hi *= 0.5
+                        sc_lo = 1.0
+                        side = -1
+                eta1[:] = etab
+                etad1[:] = etadb
+                w1[:] = wb
+                wd1[:] = wdb
+                lam1[:] = lamb
+                s1[:] = sb
+                g1[:] = gb
+                # g0 was overwritten by identical values (same start state) in every trial
+            tau_end = tau + theta_hi * (1.0 - tau)
+            if any_ev and theta_hi < 1.0:
+                frac_hi = tau_end
+            else:
+                frac_hi = 1.0
+                tau_end = 1.0
+            h_acc = (frac_hi - tau) * dt
+            n_sub_total += 1
+            if track_energy:
+                if full and frac_hi >= 1.0:
+                    Eacc = c_E[slot]
+                else:
+                    _mode_matrices(nu2, cc, h_acc, Esub)
+                    Eacc = Esub
+                ag_b = _interp(ag[step], ag[step + 1], frac_hi)
+                for j in range(m):
+                    N_e[j] = _interp(N[step, j], N[step + 1, j], frac_hi)
+                _energy_substep(h_acc, Eacc, nu2, cc, R, eta, etad, g0, g1, mass, mud,
+                                on_struct, stuck, sig, w, wd, ag0, ag_b, N0, N_e, ework)
+                E_in += ework[0]
+                E_damp += ework[1]
+                E_fric += ework[2]
+            eta[:] = eta1
+            etad[:] = etad1
+            w[:] = w1
+            wd[:] = wd1
+            lam[:] = lam1
+            s[:] = s1
+            if frac_hi >= 1.0:
+                break
+            # --- transition at t_e = (step + tau_end) dt
+            t_e = t_offset + (step + tau_end) * dt
+            ag_e = _interp(ag[step], ag[step + 1], tau_end)
+            for i in range(n):
+                pe_t[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
+            for j in range(m):
+                N_e[j] = _interp(N[step, j], N[step + 1, j], tau_end)
+            _to_physical(c_psi[slot], eta, etad, q, qd)
+            _event_values(stuck, sig, lam, N_e, s, mus, e_try)
+            old_stuck = stuck.copy()
+            old_sig = sig.copy()
+            _mv(P, qd, vn)
+            for j in range(m):
+                cand[j] = False
+                forced[j] = False
+                if old_stuck[j]:
+                    if e_try[j] > -1e-7 * mus[j] * N_e[j] - tolF[j]:
+                        forced[j] = True
+                        sig[j] = -1.0 if lam[j] > 0.0 else 1.0
+                    else:
+                        cand[j] = True
+                else:
+                    vs = abs(wd[j]) + abs(vn[j]) + 1e-30
+                    if e_try[j] > -1e-9 * vs:
+                        cand[j] = True
+                        wd[j] = vn[j]
+            _consistent(w2, cd, Cq, True, P, B, mass, mus, mud, q, qd, ag_e, pe_t, N_e,
+                        stuck, sig, cand, forced, qdd, wdd, lam)
+            for j in range(m):
+                s[j] = wd[j] - vn[j]
+                kind = -1
+                if old_stuck[j] and not stuck[j]:
+                    kind = KIND_SLIP
+                elif (not old_stuck[j]) and stuck[j]:
+                    kind = KIND_STICK
+                elif (not old_stuck[j]) and (not stuck[j]) and sig[j] != old_sig[j]:
+                    kind = KIND_REVERSE
+                if kind >= 0:
+                    if n_ev < max_events:
+                        ev_time[n_ev] = t_e
+                        ev_slider[n_ev] = j
+                        ev_kind[n_ev] = kind
+                    n_ev += 1
+            changed = False
+            for j in range(m):
+                if on_struct[j] and stuck[j] != old_stuck[j]:
+                    changed = True
+            if changed:
+                stamp += 1
+                _cfg_key(stuck, on_struct, key)
+                slot, built = _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd,
+                                           a1, fixed, P, mass, pat, dt, c_psi, c_psitm, c_nu2,
+                                           c_cc, c_R, c_gpat, c_gsl, c_E)
+                if built:
+                    n_built += 1
+                _to_modal(c_psitm[slot], q, qd, eta, etad)
+            tau = tau_end
+        if status != STATUS_OK:
+            break
+        k = step + 1
+        _to_physical(c_psi[slot], eta, etad, q, qd)
+        for i in range(n):
+            pe_t[i] = pext[k, i]
+        _equilibrium_qdd(w2, cd, P, pe_t, q, qd, lam, qdd)
+        out_q[k, :] = q
+        out_qd[k, :] = qd
+        out_qdd[k, :] = qdd
+        out_w[k, :] = w
+        out_wd[k, :] = wd
+        out_lam[k, :] = lam
+        for j in range(m):
+            out_stuck[k, j] = stuck[j]
+        if track_energy:
+            ke = 0.5 * np.dot(qd, qd)
+            for j in range(m):
+                ke += 0.5 * mass[j] * wd[j] * wd[j]
+            se = 0.0
+            for i in range(n):
+                se += 0.5 * w2[i] * q[i] * q[i]
+            out_energy[k, 0] = E_in
+            out_energy[k, 1] = ke
+            out_energy[k, 2] = se
+            out_energy[k, 3] = E_damp
+            out_energy[k, 4] = E_fric
+        if not np.isfinite(q[0]):
+            status = STATUS_NONFINITE
+            break
+    if n_ev > max_events and status == STATUS_OK:
+        status = STATUS_EVENT_OVERFLOW
+    w_state[:] = w
+    wd_state[:] = wd
+    stuck_state[:] = stuck
+    sig_state[:] = sig
+    e_state[0] = E_in
+    e_state[1] = E_damp
+    e_state[2] = E_fric
+    return status, n_ev, n_sub_total, n_built
