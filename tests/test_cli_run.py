@@ -219,3 +219,13 @@ def test_subprocess_json_and_error(rec_csv, tmp_path: Path):
     bad = run("--motion", str(tmp_path / "missing.at2"))
     assert bad.returncode == 2
     assert "missing.at2" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_method_option(capsys, rec_csv):
+    """--method picks the time integration; both agree closely on the paper rack (dt = 5 ms)."""
+    exact = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3")
+    newmark = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--method", "newmark")
+    assert (exact["integration"], newmark["integration"]) == ("exact", "newmark")
+    a = exact["peaks"]["beam_displacement_m"]
+    b = newmark["peaks"]["beam_displacement_m"]
+    assert a == pytest.approx(b, rel=5e-3) and a != b

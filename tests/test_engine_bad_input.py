@@ -125,3 +125,17 @@ def test_sliders_reject(field, kwargs):
     with pytest.raises(InputError) as info:
         Sliders(**args)
     assert info.value.field == field and f"'{field}'" in str(info.value), str(info.value)
+
+
+def test_method_names_and_exact_needs_classical_damping():
+    M, C, K, sl, kw = _ok()
+    with pytest.raises(InputError) as exc:
+        simulate(M, C, K, sl, method="rk4", **kw)
+    assert exc.value.field == "method"
+    rayleigh = 0.5 * M + 0.01 * K  # mass term: not classical once the slider sticks
+    with pytest.raises(InputError) as exc:
+        simulate(M, rayleigh, K, sl, method="exact", **kw)
+    assert exc.value.field == "method" and "not classical" in str(exc.value)
+    # "auto" falls back to Newmark there, and takes the exact kernel for C = 0.01 K
+    assert simulate(M, rayleigh, K, sl, **kw).method == "newmark"
+    assert simulate(M, C, K, sl, **kw).method == "exact"

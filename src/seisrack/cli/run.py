@@ -54,6 +54,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("--dt", type=float, metavar="DT",
                    help="[s] analysis time step, the record dt divided by a whole number "
                         "(default: the largest such step <= 5 ms)")
+    p.add_argument("--method", choices=("auto", "exact", "newmark"), default="auto",
+                   help="time integration: exact modal propagators per contact configuration "
+                        "(needs no damping or stiffness-proportional damping), Newmark average "
+                        "acceleration, or auto (exact when it applies; default)")
     p.add_argument("--free-vibration", type=float, default=0.0, metavar="S",
                    help="[s] of free vibration after the record (default 0)")
     p.add_argument("--out", metavar="DIR", help=_OUT_HELP)
@@ -200,14 +204,15 @@ def run(args: argparse.Namespace) -> int:
     bar = _progress_bar(n_steps)
     try:
         resp = run_rack(model, rec, dt=rec.dt / k, vertical=vert,
-                        free_vibration=args.free_vibration,
+                        free_vibration=args.free_vibration, method=args.method,
                         progress=None if bar is None else bar.update)
     finally:
         if bar is not None:
             bar.close()
 
     summary = resp.summary()
-    summary = {"rack": args.rack, "title": spec.title, **summary}
+    summary = {"rack": args.rack, "title": spec.title, **summary,
+               "integration": resp.history.method}
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot)  # adds summary["outputs"]
     if args.json:
