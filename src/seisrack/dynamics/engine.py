@@ -1,9 +1,10 @@
 """Entry point of the stick–slip engine: validate, transform to modal coordinates, integrate.
 
 The structure is linear (M, C, K); the sliders are masses resting on structural DOFs with
-Coulomb friction (paper §II–III; law as in issue #3). The integration is Newmark average
-acceleration with exact event location inside the step, so results converge at second order
-and a step never "fails to converge". See ``docs/theory/stick_slip_engine.md``.
+Coulomb friction (paper §II–III; law as in issue #3). Each contact phase is integrated either in
+closed form with the modes of its contact configuration ("exact", when damping is classical in
+every configuration) or by Newmark average acceleration, with exact event location inside the
+step, so a step never "fails to converge". See ``docs/theory/stick_slip_engine.md``.
 """
 
 from __future__ import annotations
