@@ -1,18 +1,22 @@
 """2D Euler–Bernoulli frame finite elements: matrices, assembly, damping, modes, recovery."""
 
-from seisrack.fe.assembly import assemble, scatter
+from seisrack.fe.assembly import assemble, assemble_sparse, scatter
 from seisrack.fe.mesh import FrameMesh, line_mesh
 from seisrack.fe.modal import ModalResult, modal_analysis, modal_from_matrices
 from seisrack.fe.recovery import (
+    RecoveryOperators,
     UprightMoments,
     base_reactions,
     element_end_forces,
+    recovery_operators,
     support_reactions,
     upright_moments,
 )
+from seisrack.fe.stability import is_positive_definite
 
 __all__ = [
-    "FrameMesh", "ModalResult", "UprightMoments", "assemble", "base_reactions",
-    "element_end_forces", "line_mesh", "modal_analysis", "modal_from_matrices", "scatter",
+    "FrameMesh", "ModalResult", "RecoveryOperators", "UprightMoments", "assemble",
+    "assemble_sparse", "base_reactions", "element_end_forces", "is_positive_definite",
+    "line_mesh", "modal_analysis", "modal_from_matrices", "recovery_operators", "scatter",
     "support_reactions", "upright_moments",
 ]

@@ -3,7 +3,8 @@
 As in scikit-fem, the loop (implicit, via broadcasting) runs over local entries, never over
 elements: the (n_el, k, k) blocks and their (n_el, k) DOF tables are flattened into COO triplets,
 restrained entries (DOF ``-1``) are dropped, and duplicates are summed by the COO → CSR
-conversion.
+conversion. :func:`assemble_sparse` is the primary form (memory O(nnz)); :func:`assemble` densifies
+it for small problems and tests.
 """
 
 from __future__ import annotations
@@ -30,24 +31,28 @@ def spring_blocks(k: FloatArray) -> FloatArray:
     return k[:, None, None] * np.array([[1.0, -1.0], [-1.0, 1.0]])
 
 
-def assemble(mesh: FrameMesh) -> tuple[FloatArray, FloatArray]:
-    """Dense global stiffness K [N/m …] and consistent mass M [kg …], each (n_dof, n_dof)."""
+def symmetric_csr(A: sp.spmatrix) -> sp.csr_matrix:
+    """(A + Aᵀ)/2 as a CSR matrix in canonical form (sorted indices, no duplicates)."""
+    S = (0.5 * (A + A.T)).tocsr()
+    S.sum_duplicates()
+    S.sort_indices()
+    return S
+
+
+def assemble_sparse(mesh: FrameMesh) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Global stiffness K [N/m …] and consistent mass M [kg …], each (n_dof, n_dof) CSR.
+
+    Both are exactly symmetric (averaged with their transpose) and in canonical CSR form.
+    """
     ke, me = element_matrices(mesh)
-    blocks_k = np.concatenate([ke.reshape(-1, 36), _pad_springs(mesh)], axis=0)
-    dofs = np.concatenate([mesh.element_dofs, _spring_dofs6(mesh)], axis=0)
-    K = scatter(blocks_k.reshape(-1, 6, 6), dofs, mesh.n_dof).toarray()
-    M = scatter(me, mesh.element_dofs, mesh.n_dof).toarray()
-    return 0.5 * (K + K.T), 0.5 * (M + M.T)
+    K = scatter(ke, mesh.element_dofs, mesh.n_dof)
+    if mesh.springs.shape[0]:
+        K = K + scatter(spring_blocks(mesh.spring_k), mesh.springs, mesh.n_dof)
+    M = scatter(me, mesh.element_dofs, mesh.n_dof)
+    return symmetric_csr(K), symmetric_csr(M)
 
 
-def _pad_springs(mesh: FrameMesh) -> FloatArray:
-    """Springs as 6x6 blocks (2x2 in the corner) so one scatter handles everything."""
-    out = np.zeros((mesh.springs.shape[0], 6, 6))
-    out[:, :2, :2] = spring_blocks(mesh.spring_k)
-    return out.reshape(-1, 36)
-
-
-def _spring_dofs6(mesh: FrameMesh) -> IntArray:
-    out = np.full((mesh.springs.shape[0], 6), -1, dtype=np.int64)
-    out[:, :2] = mesh.springs
-    return out
+def assemble(mesh: FrameMesh) -> tuple[FloatArray, FloatArray]:
+    """Dense global stiffness K and consistent mass M, each (n_dof, n_dof): for small meshes."""
+    K, M = assemble_sparse(mesh)
+    return K.toarray(), M.toarray()

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from seisrack.fe.elements import local_stiffness, rotation
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
@@ -134,3 +135,97 @@ def upright_moments(model: Any, U: FloatArray) -> UprightMoments:
     above_idx = model.upright_above_elements
     above = np.where(above_idx >= 0, -f[:, np.maximum(above_idx, 0), 2], 0.0)
     return UprightMoments(base=base, below=below, above=above)
+
+
+@dataclass(frozen=True)
+class RecoveryOperators:
+    """Sparse linear maps from free-DOF displacements to rack forces: ``U @ op``.
+
+    For ``U: (n_t, n_dof)`` [m, rad] each product is exactly the corresponding function of this
+    module evaluated on ``U`` (elastic forces only, same sign conventions):
+
+    Attributes:
+        base_shear: (n_dof, 1) CSR; ``U @ base_shear`` (n_t, 1) [N] is the base shear
+            ``-base_reactions(model, U)[..., 0].sum(-1)``.
+        base_moment: (n_dof, n_upright) CSR; ``U @ base_moment`` [N·m] is
+            ``upright_moments(model, U).base``.
+        below, above: (n_dof, n_upright·n_level) CSR; ``U @ below`` [N·m] is
+            ``upright_moments(model, U).below`` flattened over (upright, level), upright-major
+            (column ``u·n_level + l``); likewise ``above`` (columns above the top level are 0).
+        n_upright, n_level: the shapes to unflatten with.
+
+    Each column has at most a dozen non-zeros (one element's stiffness row), so the operators
+    cost O(n_upright·n_level) memory, unlike evaluating the functions on ``np.eye(n_dof)``.
+    """
+
+    base_shear: sp.csr_matrix
+    base_moment: sp.csr_matrix
+    below: sp.csr_matrix
+    above: sp.csr_matrix
+    n_upright: int
+    n_level: int
+
+    def upright_moments(self, U: FloatArray) -> UprightMoments:
+        """:class:`UprightMoments` of ``U: (n_t, n_dof)`` through the operators."""
+        U2, _ = _as_2d(U)
+        shape = (U2.shape[0], self.n_upright, self.n_level)
+        return UprightMoments(base=np.asarray(U2 @ self.base_moment),
+                              below=np.asarray(U2 @ self.below).reshape(shape),
+                              above=np.asarray(U2 @ self.above).reshape(shape))
+
+
+def recovery_operators(model: Any) -> RecoveryOperators:
+    """Build the :class:`RecoveryOperators` of a FrameModel from its element stiffness rows."""
+    mesh = _mesh(model)
+    n = mesh.n_dof
+    edofs = mesh.element_dofs  # (n_el, 6)
+    c, s = mesh.direction_cosines
+    T = rotation(c, s)
+    kt = np.einsum("eij,ejk->eik", local_stiffness(mesh.E, mesh.A, mesh.I, mesh.lengths), T)
+    kg = np.einsum("eji,ejk->eik", T, kt)  # Tᵀ k T: global end forces from u_e
+
+    # Base shear: -Σ Fx over the base nodes. A restrained ux reacts with the sum of the global
+    # x end forces of the elements meeting there; a free ux with its ground spring, -k·u.
+    base = np.asarray(model.base_nodes, dtype=np.int64)
+    is_base = np.zeros(mesh.nodes.shape[0], dtype=bool)
+    is_base[base] = True
+    fixed_x = mesh.node_dofs[:, 0] < 0
+    rows, vals = [], []
+    for end in (0, 1):  # the two ends of every element, not a loop over elements
+        hit = is_base[mesh.elements[:, end]] & fixed_x[mesh.elements[:, end]]
+        rows.append(edofs[hit])
+        vals.append(-kg[hit, 3 * end, :])  # minus: base shear = -Σ Fx
+    free_x = mesh.node_dofs[base, 0][mesh.node_dofs[base, 0] >= 0]
+    rows.append(free_x[:, None])
+    vals.append(mesh.ground_spring_k[free_x][:, None])  # -(-k·u)
+    shear = _columns(np.concatenate([r.ravel() for r in rows]),
+                     np.zeros(sum(r.size for r in rows), dtype=np.int64),
+                     np.concatenate([v.ravel() for v in vals]), n, 1)
+
+    n_up, n_lev = np.asarray(model.upright_below_elements).shape
+    base_m = _element_rows(kt, edofs, np.asarray(model.upright_base_elements), 2, -1.0, n)
+    below = _element_rows(kt, edofs, np.asarray(model.upright_below_elements).ravel(), 5, 1.0, n)
+    above = _element_rows(kt, edofs, np.asarray(model.upright_above_elements).ravel(), 2, -1.0, n)
+    return RecoveryOperators(base_shear=shear, base_moment=base_m, below=below, above=above,
+                             n_upright=int(n_up), n_level=int(n_lev))
+
+
+def _element_rows(kt: FloatArray, edofs: IntArray, elems: IntArray, comp: int, factor: float,
+                  n_dof: int) -> sp.csr_matrix:
+    """(n_dof, len(elems)) CSR: column j = factor · row ``comp`` of k·T of element ``elems[j]``
+    (a zero column where ``elems[j] < 0``)."""
+    ok = elems >= 0
+    cols = np.repeat(np.flatnonzero(ok), 6)
+    e = elems[ok]
+    return _columns(edofs[e].ravel(), cols, factor * kt[e, comp, :].ravel(), n_dof, elems.size)
+
+
+def _columns(rows: IntArray, cols: IntArray, vals: FloatArray, n_dof: int, n_col: int
+             ) -> sp.csr_matrix:
+    """Sum COO triplets into an (n_dof, n_col) CSR, dropping restrained rows (-1)."""
+    keep = rows >= 0
+    out = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(n_dof, n_col)).tocsr()
+    out.sum_duplicates()
+    out.eliminate_zeros()
+    out.sort_indices()
+    return out

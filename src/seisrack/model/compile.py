@@ -1,8 +1,10 @@
 """Compile a :class:`RackSpec` into a :class:`FrameModel` (arrays only).
 
-Steps: mesh (:mod:`seisrack.model.rack_mesh`) → vectorised assembly of K and consistent M
-(:mod:`seisrack.fe.assembly`) → pallets (vertical mass on their node's uy DOF; horizontal mass
-kept apart as sliders) → damping (:mod:`seisrack.fe.damping`).
+Steps: mesh (:mod:`seisrack.model.rack_mesh`) → vectorised sparse assembly of K and consistent
+M (:mod:`seisrack.fe.assembly`) → stability check (sparse LDLᵀ pivots,
+:func:`seisrack.fe.stability.is_positive_definite`) → pallets (vertical mass on their node's uy
+DOF; horizontal mass kept apart as sliders) → damping (:mod:`seisrack.fe.damping`, the first
+period by sparse shift-invert Lanczos). Nothing here forms a dense (n_dof, n_dof) matrix.
 """
 
 from __future__ import annotations
@@ -11,13 +13,14 @@ import dataclasses
 import logging
 
 import numpy as np
-import scipy.linalg
+import scipy.sparse as sp
 
 from seisrack.errors import InputError
 from seisrack.fe import damping as fe_damping
-from seisrack.fe.assembly import assemble
+from seisrack.fe.assembly import assemble_sparse, symmetric_csr
 from seisrack.fe.mesh import FloatArray
 from seisrack.fe.modal import modal_from_matrices
+from seisrack.fe.stability import is_positive_definite
 from seisrack.model.frame_model import FrameModel
 from seisrack.model.rack_mesh import RackMesh, build_rack_mesh
 from seisrack.model.spec import Connections, Pallet, RackSpec
@@ -29,7 +32,7 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     """Build the frame model of ``spec``; raises InputError if the frame is a mechanism."""
     rm = build_rack_mesh(spec)
     mesh = rm.mesh
-    K, M = assemble(mesh)
+    K, M = assemble_sparse(mesh)
     _check_stable(K, spec)
 
     n_p = len(spec.pallets)
@@ -37,14 +40,14 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     p_dof = mesh.node_dofs[p_node, 0] if n_p else np.zeros(0, dtype=np.int64)
     p_vdof = mesh.node_dofs[p_node, 1] if n_p else np.zeros(0, dtype=np.int64)
     p_mass = np.array([p.mass for p in spec.pallets], dtype=float)
-    np.add.at(M, (p_vdof, p_vdof), p_mass)  # vertical pallet mass moves with its node
+    M = symmetric_csr(M + _diagonal(p_vdof, p_mass, mesh.n_dof))  # vertical pallet mass
     lim_neg, lim_pos = sliding_limits(spec)
 
     r_x = _influence(mesh.node_dofs[:, 0], mesh.n_dof)
     r_y = _influence(mesh.node_dofs[:, 1], mesh.n_dof)
-    Mt = M.copy()
-    np.add.at(Mt, (p_dof, p_dof), p_mass)
+    Mt = M + _diagonal(p_dof, p_mass, mesh.n_dof)  # pallets rigidly attached
     a0, a1 = _damping(spec, K, Mt, r_x, r_y)
+    C = symmetric_csr(a0 * M + a1 * K)
 
     level_dofs = []
     for lev in range(spec.geometry.n_levels):
@@ -56,7 +59,7 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     log.info("compiled rack: %d nodes, %d elements, %d DOFs, %d pallets",
              mesh.nodes.shape[0], mesh.n_el, mesh.n_dof, n_p)
     return _read_only(FrameModel(
-        mesh=mesh, K=K, M=M, C=a0 * M + a1 * K, damping_coefficients=(a0, a1),
+        mesh=mesh, K_sparse=K, M_sparse=M, C_sparse=C, damping_coefficients=(a0, a1),
         r_x=r_x, r_y=r_y, pallet_dof=p_dof, pallet_vdof=p_vdof, pallet_node=p_node,
         pallet_mass=p_mass,
         pallet_mu_static=np.array([p.mu_static for p in spec.pallets], dtype=float),
@@ -81,11 +84,14 @@ def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:
     """
     n = len(spec.pallets)
     neg, pos = np.zeros(n), np.zeros(n)
+    shelves: dict[tuple[int, int], list[Pallet]] = {}  # pallets sharing a bay and level
+    for p in spec.pallets:
+        shelves.setdefault((p.bay, p.level), []).append(p)
     for i, p in enumerate(spec.pallets):
         left, right = p.position - p.width / 2, p.position + p.width / 2
         wall_l, wall_r = 0.0, spec.geometry.bays[p.bay - 1]
-        for q in spec.pallets:
-            if q is p or (q.bay, q.level) != (p.bay, p.level):
+        for q in shelves[(p.bay, p.level)]:
+            if q is p:
                 continue
             if q.position < p.position:
                 wall_l = max(wall_l, q.position + q.width / 2)
@@ -98,14 +104,26 @@ def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:
 
 
 def _read_only(model: FrameModel) -> FrameModel:
-    """Lock every array of the compiled model (it is shared, never mutated)."""
+    """Lock every array of the compiled model (it is shared, never mutated).
+
+    Sparse matrices are locked through their ``data``, ``indices`` and ``indptr`` arrays; they
+    are canonical, so SciPy never needs to sort or merge them in place.
+    """
     for obj in (model, model.mesh):
         for f in dataclasses.fields(obj):
             value = getattr(obj, f.name)
             for arr in value if isinstance(value, tuple) else (value,):
-                if isinstance(arr, np.ndarray):
+                if sp.issparse(arr):
+                    for part in (arr.data, arr.indices, arr.indptr):
+                        part.flags.writeable = False
+                elif isinstance(arr, np.ndarray):
                     arr.flags.writeable = False
     return model
+
+
+def _diagonal(dofs: np.ndarray, values: FloatArray, n_dof: int) -> sp.csr_matrix:
+    """(n_dof, n_dof) CSR with ``values`` summed on the diagonal at ``dofs``."""
+    return sp.csr_matrix((values, (dofs, dofs)), shape=(n_dof, n_dof))
 
 
 def _pallet_node(rm: RackMesh, p: Pallet) -> int:
@@ -119,21 +137,19 @@ def _influence(dofs: np.ndarray, n_dof: int) -> FloatArray:
     return r
 
 
-def _check_stable(K: FloatArray, spec: RackSpec) -> None:
-    try:
-        scipy.linalg.cho_factor(K)
-    except np.linalg.LinAlgError:
+def _check_stable(K: sp.csr_matrix, spec: RackSpec) -> None:
+    if not is_positive_definite(K):
         c = spec.connections
         raise InputError(
             "connections", {"beam_to_upright": Connections.describe_value(c.beam_to_upright),
                             "base": Connections.describe_value(c.base)},
             "connections that make the frame stable (pinned bases need beam-to-upright "
             "joints with a stiffness > 0)", source=spec.source,
-            hint="The stiffness matrix is singular: the frame is a sway mechanism") from None
+            hint="The stiffness matrix is singular: the frame is a sway mechanism")
 
 
-def _damping(spec: RackSpec, K: FloatArray, Mt: FloatArray, r_x: FloatArray, r_y: FloatArray
-             ) -> tuple[float, float]:
+def _damping(spec: RackSpec, K: sp.csr_matrix, Mt: sp.csr_matrix, r_x: FloatArray,
+             r_y: FloatArray) -> tuple[float, float]:
     d = spec.damping
     if d.kind == "stiffness":
         if d.period == "first":

@@ -2,15 +2,21 @@
 
 Field meanings are the contract in ``docs/dev/interfaces.md``. Only free DOFs appear in the
 matrices (supports removed). Nothing here is mutated after compilation; results live elsewhere.
+The matrices are stored sparse (CSR), so a warehouse rack of thousands of DOFs costs O(nnz)
+memory; dense views exist for small racks and for code that has not moved to sparse yet.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
 
-import numpy as np
+import scipy.sparse as sp
 
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
+
+_DENSE_CACHE = ("K", "M", "C")
 
 UPRIGHT = 0
 BEAM = 1
@@ -21,10 +27,16 @@ class FrameModel:
     """Compiled 2D frame model of a rack.
 
     Matrices (free DOFs only):
-        K, M, C: (n_dof, n_dof) [N/m, kg, N·s/m]. ``M`` is the structure mass: members
-            (consistent) plus each pallet's *vertical* mass on its node's uy DOF. The pallets'
-            horizontal masses are not in ``M`` (they are the sliders);
-            :meth:`total_mass_matrix` adds them back as if rigidly attached.
+        K_sparse, M_sparse, C_sparse: (n_dof, n_dof) ``scipy.sparse.csr_matrix``, symmetric,
+            canonical (sorted indices, no duplicates), read-only [N/m, kg, N·s/m]. ``M_sparse``
+            is the structure mass: members (consistent) plus each pallet's *vertical* mass on its
+            node's uy DOF. The pallets' horizontal masses are not in it (they are the sliders);
+            :meth:`total_mass_sparse` / :meth:`total_mass_matrix` add them back as if rigidly
+            attached.
+        K, M, C: (n_dof, n_dof) dense read-only ``ndarray`` views of the same matrices, built on
+            first access and cached (dropped when pickled). For small racks, tests and callers
+            not yet on sparse: at 5,000 DOFs each is 200 MB, so large-rack code must use the
+            ``*_sparse`` fields.
         damping_coefficients: (a0, a1) with C = a0·M + a1·K.
         r_x, r_y: (n_dof,) influence vectors of horizontal / vertical ground motion.
 
@@ -53,9 +65,9 @@ class FrameModel:
     """
 
     mesh: FrameMesh
-    K: FloatArray
-    M: FloatArray
-    C: FloatArray
+    K_sparse: sp.csr_matrix
+    M_sparse: sp.csr_matrix
+    C_sparse: sp.csr_matrix
     damping_coefficients: tuple[float, float]
     r_x: FloatArray
     r_y: FloatArray
@@ -84,7 +96,7 @@ class FrameModel:
 
     @property
     def n_dof(self) -> int:
-        return int(self.K.shape[0])
+        return int(self.K_sparse.shape[0])
 
     @property
     def n_pallets(self) -> int:
@@ -105,8 +117,43 @@ class FrameModel:
         """(n_node, 3) int, -1 = restrained."""
         return self.mesh.node_dofs
 
-    def total_mass_matrix(self) -> FloatArray:
-        """(n_dof, n_dof) [kg]: ``M`` plus the pallets' horizontal masses, rigidly attached."""
-        Mt = self.M.copy()
-        np.add.at(Mt, (self.pallet_dof, self.pallet_dof), self.pallet_mass)
+    @cached_property
+    def K(self) -> FloatArray:  # noqa: N802
+        """(n_dof, n_dof) [N/m] dense, read-only copy of ``K_sparse`` (small racks only)."""
+        return _dense(self.K_sparse)
+
+    @cached_property
+    def M(self) -> FloatArray:  # noqa: N802
+        """(n_dof, n_dof) [kg] dense, read-only copy of ``M_sparse`` (small racks only)."""
+        return _dense(self.M_sparse)
+
+    @cached_property
+    def C(self) -> FloatArray:  # noqa: N802
+        """(n_dof, n_dof) [N·s/m] dense, read-only copy of ``C_sparse`` (small racks only)."""
+        return _dense(self.C_sparse)
+
+    def total_mass_sparse(self) -> sp.csr_matrix:
+        """(n_dof, n_dof) [kg] CSR: ``M_sparse`` plus the pallets' horizontal masses, rigidly
+        attached (a fresh matrix)."""
+        n = self.n_dof
+        pallets = sp.csr_matrix((self.pallet_mass, (self.pallet_dof, self.pallet_dof)),
+                                shape=(n, n))
+        Mt = (self.M_sparse + pallets).tocsr()
+        Mt.sum_duplicates()
+        Mt.sort_indices()
         return Mt
+
+    def total_mass_matrix(self) -> FloatArray:
+        """(n_dof, n_dof) [kg] dense, writable: ``M`` plus the pallets' horizontal masses,
+        rigidly attached (small racks; see :meth:`total_mass_sparse`)."""
+        return self.total_mass_sparse().toarray()
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The dense views are caches: do not ship them to worker processes.
+        return {k: v for k, v in self.__dict__.items() if k not in _DENSE_CACHE}
+
+
+def _dense(A: sp.spmatrix) -> FloatArray:
+    out = A.toarray()
+    out.flags.writeable = False
+    return out
