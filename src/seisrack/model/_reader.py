@@ -3,6 +3,7 @@
 A :class:`Table` wraps one TOML table with its dotted path (``pallets[2]``). Each getter checks
 presence, type and finiteness and raises :class:`~seisrack.errors.InputError` naming the full
 field path, the value received and what is allowed. :meth:`Table.finish` reports unknown keys.
+:func:`check_number` and :func:`check_friction` validate single values outside a table.
 """
 
 from __future__ import annotations
@@ -114,3 +115,14 @@ def check_number(value: Any, field: str, *, positive: bool = False, nonnegative:
     if nonnegative and not x >= 0.0:
         raise InputError(field, value, what, source=source)
     return x
+
+
+def check_friction(f_static: str, mu_s: Any, f_dynamic: str, mu_d: Any,
+                   source: str | None = None) -> tuple[float, float]:
+    """Validate a (static, dynamic) friction pair: both >= 0 and dynamic <= static."""
+    s = check_number(mu_s, f_static, nonnegative=True, source=source)
+    k = check_number(mu_d, f_dynamic, nonnegative=True, source=source)
+    if k > s:
+        raise InputError(f_dynamic, mu_d, f"a value <= {f_static} ({s:g})", source=source,
+                         hint="The dynamic friction coefficient cannot exceed the static one")
+    return s, k

@@ -4,6 +4,9 @@ Everything a user can get wrong is caught here and reported as an
 :class:`~seisrack.errors.InputError` naming the field path (``pallets[2].mu_dynamic``), the value
 and what is allowed; malformed TOML becomes a :class:`~seisrack.errors.FileFormatError` with the
 line number.
+
+``geometry.bays`` and ``geometry.levels`` are arrays of lengths or ``{count, pitch}`` tables; the
+optional ``[loading]`` table generates pallets (:mod:`seisrack.model.loading`).
 """
 
 from __future__ import annotations
@@ -15,7 +18,8 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
-from seisrack.model._reader import Table, check_number
+from seisrack.model._reader import Table, check_friction, check_number
+from seisrack.model.loading import place_pallets, read_loading
 from seisrack.model.spec import (
     DEFAULT_G,
     DEFAULT_PALLET_WIDTH,
@@ -31,7 +35,8 @@ from seisrack.model.spec import (
     Section,
 )
 
-_TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping", "pallets")
+_TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping",
+             "loading", "pallets")
 _LINE_RE = re.compile(r"\(at line (\d+), column (\d+)\)")
 _GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
 
@@ -67,25 +72,19 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     connections = _connections(root.table("connections"))
     damping = _damping(root.table("damping", {}))
     raw_pallets = root.array("pallets", [])
-    pallets = tuple(
+    explicit = tuple(
         _pallet(Table(p, f"pallets[{i}]", source), geometry) for i, p in enumerate(raw_pallets)
     )
+    loading = read_loading(root.table("loading"), geometry) if root.has("loading") else None
     root.finish(_TOP_KEYS)
-    _check_overlaps(pallets, source)
+    pallets, labels = place_pallets(loading, geometry, explicit)
+    _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
                     title=title, source=source)
 
 
-def check_friction(f_static: str, mu_s: Any, f_dynamic: str, mu_d: Any,
-                   source: str | None = None) -> tuple[float, float]:
-    """Validate a (static, dynamic) friction pair: both >= 0 and dynamic <= static."""
-    s = check_number(mu_s, f_static, nonnegative=True, source=source)
-    k = check_number(mu_d, f_dynamic, nonnegative=True, source=source)
-    if k > s:
-        raise InputError(f_dynamic, mu_d, f"a value <= {f_static} ({s:g})", source=source,
-                         hint="The dynamic friction coefficient cannot exceed the static one")
-    return s, k
+__all__ = ["check_friction", "load_rack", "rack_from_dict"]
 
 
 def _material(t: Table) -> Material:
@@ -122,9 +121,19 @@ def _section_names(t: Table, key: str, n: int, what: str, sections: dict[str, Se
 
 
 def _lengths(t: Table, key: str) -> tuple[float, ...]:
-    values = t.array(key, min_len=1)
+    """An array of lengths [m], or ``{count = n, pitch = h}`` for n equal lengths h."""
+    value = t.raw(key)
+    if isinstance(value, dict):
+        c = t.table(key)
+        count = c.integer("count", minimum=1)
+        pitch = c.number("pitch", positive=True, unit="m")
+        c.finish(("count", "pitch"))
+        return (pitch,) * count
+    if not isinstance(value, list) or not value:
+        raise t.error(key, value, "a non-empty array of lengths [m] or a table "
+                                  "{count = <integer >= 1>, pitch = <length > 0, m>}")
     return tuple(check_number(v, f"{t.field(key)}[{i}]", positive=True, unit="m",
-                              source=t.source) for i, v in enumerate(values))
+                              source=t.source) for i, v in enumerate(value))
 
 
 def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
@@ -232,15 +241,18 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
                   mu_dynamic=mu_d, width=width, sliding_limit=limit)
 
 
-def _check_overlaps(pallets: tuple[Pallet, ...], source: str | None) -> None:
+def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],
+                    source: str | None) -> None:
+    """Pallets on the same bay and level must not overlap (``labels[i]`` names pallet i)."""
+    seen: dict[tuple[int, int], list[int]] = {}  # earlier pallets of each (bay, level)
     for i, a in enumerate(pallets):
-        for j in range(i):
+        earlier = seen.setdefault((a.bay, a.level), [])
+        for j in earlier:
             b = pallets[j]
-            if (a.bay, a.level) != (b.bay, b.level):
-                continue
             gap = abs(a.position - b.position) - (a.width + b.width) / 2
             if gap < -_GEOM_TOL:
                 raise InputError(
-                    f"pallets[{i}].position", a.position,
-                    f"a position that does not overlap pallets[{j}] (centre {b.position:g} m, "
+                    f"{labels[i]}.position", a.position,
+                    f"a position that does not overlap {labels[j]} (centre {b.position:g} m, "
                     f"width {b.width:g} m) on bay {a.bay}, level {a.level}", source=source)
+        earlier.append(i)
