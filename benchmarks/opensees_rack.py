@@ -27,13 +27,27 @@ Mapping from the compiled :class:`seisrack.model.FrameModel` (``model.mesh``):
   ``zeroLength`` with an ``Elastic`` material of the same stiffness, between the two nodes
   owning the DOFs (a fixed extra node for a spring to the ground), with ``-doRayleigh 1`` since
   seisrack's K (and so C = a0 M + a1 K) contains them;
-- a pallet's vertical mass is nodal mass on the beam node's uy (as in seisrack's M); its
-  horizontal mass sits on its own node (uy, rz fixed) tied to the beam node by a ``zeroLength``
-  with ``ElasticPP(kInit, eps_y = mu m g / kInit)`` in direction 1 — a regularised Coulomb law
-  with equal static and dynamic coefficients. It has no Rayleigh damping (seisrack's sliders
-  carry none either);
+- a pallet's vertical mass is nodal mass on the uy of the node owning ``pallet_vdof`` (as in
+  seisrack's M; several pallets on one node add up). Its horizontal mass sits on its own node
+  (uy, rz fixed) at that place, joined to the node owning ``pallet_dof`` in one of two modes:
+
+  * ``pallets="friction"`` (default): a ``zeroLength`` with ``ElasticPP(kInit, eps_y =
+    mu m g / kInit)`` in direction 1 — a regularised Coulomb law with a constant normal force
+    m g and equal static and dynamic coefficients. Why not ``flatSliderBearing`` with a
+    ``Coulomb`` friction model: it reads N from the bearing's axial force, so it needs a
+    vertical pallet DOF and a gravity pre-analysis, and it is regularised by the same
+    elastic–perfectly-plastic kInit; without vertical excitation N = m g is constant and both
+    give the same law. Neither can hold mu_s > mu_d (the static coefficient is used);
+  * ``pallets="rigid"``: an ``equalDOF`` in ux (no element, no sliding, no extra stiffness):
+    the pallet moves with its beam node, as seisrack's sliders that never slip.
+
+  Either way the pallet mass has no Rayleigh damping (seisrack's sliders carry none, and its
+  ``M`` in C = a0 M + a1 K excludes their horizontal masses);
 - damping: ``rayleigh a0 a1 0 0`` (current-stiffness proportional; every member is elastic so
-  current = initial); the ``a0 M`` part, if any, is restricted to the structure by regions;
+  current = initial). When a0 != 0 it is given by regions: the structural nodes get a0 for
+  the pallets' vertical nodal masses, then the structural elements get (a0, a1) so their
+  consistent mass is damped too (in this order: see ``build``); the pallet nodes and
+  friction elements are in no region;
 - ground motion: ``UniformExcitation`` in direction 1 with a ``Path`` time series at the
   record's dt (linear interpolation, as seisrack's analysis grid);
 - Newmark average acceleration (gamma = 1/2, beta = 1/4), Newton, NormDispIncr test.
@@ -55,6 +69,8 @@ import numpy as np
 
 #: friction coefficient standing for "no sliding" in the OpenSees model
 NO_SLIDING_MU = 100.0
+#: how pallets are joined to their beam node (see the module docstring)
+PALLET_MODES = ("friction", "rigid")
 
 
 def _ops():
@@ -120,16 +136,23 @@ class OpenSeesResponse:
 
 
 def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
-          element: str = "disp") -> OpenSeesRack:
+          element: str = "disp", pallets: str = "friction") -> OpenSeesRack:
     """Wipe the OpenSees domain and build ``model`` in it (see the module docstring).
 
-    mu: friction coefficient of every pallet (scalar or (m,)); default: ``model.pallet_mu_static``.
+    Works from ``model.mesh`` and the pallet arrays only (never the assembled K, M, C), so any
+    compiled rack (levels, bays, pallets, semi-rigid joints) maps node for node.
+
+    mu: friction coefficient of every pallet (scalar or (m,)); default: ``model.pallet_mu_static``
+        (ignored when ``pallets="rigid"``).
     k_init: initial stiffness of the ElasticPP friction springs [N/m].
     element: "disp" (dispBeamColumn + Elastic section, default) or "elastic"
         (elasticBeamColumn -cMass: element-mass ground load doubled in OpenSees 3.7.1).
+    pallets: "friction" (ElasticPP zeroLength, default) or "rigid" (equalDOF in ux).
     """
     if element not in ("disp", "elastic"):
         raise ValueError(f"element must be 'disp' or 'elastic', not {element!r}")
+    if pallets not in PALLET_MODES:
+        raise ValueError(f"pallets must be one of {PALLET_MODES}, not {pallets!r}")
     ops = _ops()
     mesh = model.mesh
     ops.wipe()
@@ -218,26 +241,37 @@ def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
     mus = np.broadcast_to(
         np.asarray(model.pallet_mu_static if mu is None else mu, dtype=float), (m,))
     level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+    vertical_mass: dict[int, float] = {}  # OpenSees node -> summed pallet vertical mass
     p_beam, p_node, p_ele, p_lev = [], [], [], []
     for j in range(m):
-        bn = int(tags[int(model.pallet_node[j])])
         mass = float(model.pallet_mass[j])
-        ops.mass(bn, 0.0, mass, 0.0)  # vertical pallet mass moves with the beam
-        x, y = mesh.nodes[int(model.pallet_node[j])]
+        v_owner = owner[int(model.pallet_vdof[j])]
+        vn = int(tags[v_owner[0]])
+        vertical_mass[vn] = vertical_mass.get(vn, 0.0) + mass
+        h_owner = owner[int(model.pallet_dof[j])]
+        bn = int(tags[h_owner[0]])
+        x, y = mesh.nodes[h_owner[0]]
         pn = next_node
         next_node += 1
         ops.node(pn, float(x), float(y))
         ops.fix(pn, 0, 1, 1)
         ops.mass(pn, mass, 0.0, 0.0)
-        fy = float(mus[j]) * mass * float(model.g)
-        mat += 1
-        ops.uniaxialMaterial("ElasticPP", mat, float(k_init), fy / float(k_init))
-        ele += 1
-        ops.element("zeroLength", ele, bn, pn, "-mat", mat, "-dir", 1)
+        if pallets == "rigid":
+            ops.equalDOF(bn, pn, 1)
+            n_eq += 1
+            p_ele.append(-1)
+        else:
+            fy = float(mus[j]) * mass * float(model.g)
+            mat += 1
+            ops.uniaxialMaterial("ElasticPP", mat, float(k_init), fy / float(k_init))
+            ele += 1
+            ops.element("zeroLength", ele, bn, pn, "-mat", mat, "-dir", 1)
+            p_ele.append(ele)
         p_beam.append(bn)
         p_node.append(pn)
-        p_ele.append(ele)
         p_lev.append(level_of_dof[int(model.pallet_dof[j])])
+    for vn, mv in vertical_mass.items():  # once per node: ops.mass replaces, it does not add
+        ops.mass(vn, 0.0, mv, 0.0)
 
     # Levels: one node per distinct horizontal DOF (as seisrack's level_dofs)
     levels = [np.array([int(tags[owner[int(d)][0]]) for d in dofs]) for dofs in model.level_dofs]
@@ -246,9 +280,13 @@ def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
     if a0 == 0.0:
         ops.rayleigh(0.0, a1, 0.0, 0.0)  # pallet springs have no -doRayleigh: undamped
     else:
-        struct_nodes = [int(t) for t in tags]
-        ops.region(1, "-ele", *struct_eles, "-rayleigh", 0.0, a1, 0.0, 0.0)
-        ops.region(2, "-node", *struct_nodes, "-rayleigh", a0, 0.0, 0.0, 0.0)
+        # Nodes first: a0 on the nodal (pallet vertical) masses of the structure only. A node
+        # region also applies its factors to every element whose nodes all lie in it, so the
+        # element region must come second, or the members would lose a1 (measured: the top
+        # level of the 3 x 3 rack then peaks 1.6 % high). Elements carry (a0, a1): their
+        # consistent mass is in seisrack's M.
+        ops.region(1, "-node", *[int(t) for t in tags], "-rayleigh", a0, 0.0, 0.0, 0.0)
+        ops.region(2, "-ele", *struct_eles, "-rayleigh", a0, a1, 0.0, 0.0)
     return OpenSeesRack(
         node_tag=tags, level_nodes=levels, pallet_beam_node=np.array(p_beam, dtype=int),
         pallet_node=np.array(p_node, dtype=int), pallet_element=np.array(p_ele, dtype=int),
@@ -276,27 +314,69 @@ def _set_solver(algorithm: str, tol: float, max_iter: int) -> None:
         ops.algorithm(algorithm)
 
 
+def setup_analysis(ag: np.ndarray, ag_dt: float, *, system: str = "BandGeneral",
+                   tol: float = 1e-10, max_iter: int = 25, linear: bool = False) -> None:
+    """Ground motion, constraints, numbering, system and Newmark for the model just built.
+
+    ag: (n,) [m/s²] horizontal ground acceleration sampled at ``ag_dt`` [s] (a Path series:
+        linear interpolation, as seisrack's grid). linear: ``Linear -factorOnce`` instead of
+        Newton (valid only for a linear model at a constant step: pallets="rigid").
+    """
+    ops = _ops()
+    ops.timeSeries("Path", 1, "-dt", float(ag_dt), "-values", *np.asarray(ag, float).tolist())
+    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+    ops.constraints("Transformation")
+    ops.numberer("RCM")
+    ops.system(system)
+    ops.integrator("Newmark", 0.5, 0.25)
+    if linear:
+        ops.algorithm("Linear", "-factorOnce")
+    else:
+        _set_solver("Newton", tol, max_iter)
+    ops.analysis("Transient")
+
+
+#: outcome of :func:`advance`
+STEP_OK, STEP_RETRIED, STEP_FAILED = 0, 1, 2
+
+
+def advance(t_target: float, dt: float, tol: float = 1e-10, max_iter: int = 25) -> int:
+    """One analysis step of ``dt`` ending at ``t_target``, with the fallbacks of the module
+    docstring. Returns STEP_OK, STEP_RETRIED (converged after a fallback) or STEP_FAILED
+    (forced through with a fixed number of iterations)."""
+    ops = _ops()
+    if ops.analyze(1, dt) == 0:
+        return STEP_OK
+    outcome = STEP_FAILED
+    for n_sub, algo in ((10, "Newton"), (100, "Newton"), (10, "ModifiedNewton"),
+                        (10, "KrylovNewton")):
+        _set_solver(algo, tol, max_iter * 4)
+        if _substeps(t_target, n_sub, dt) == 0:
+            outcome = STEP_RETRIED
+            break
+    if outcome == STEP_FAILED:
+        _set_solver("FixedNumIter", tol, max_iter)
+        _substeps(t_target, 10, dt)
+    _set_solver("Newton", tol, max_iter)
+    return outcome
+
+
 def run(
     model, record, *, mu: float | np.ndarray | None = None, k_init: float = 1e8,
     dt: float = 0.005, tol: float = 1e-10, max_iter: int = 25, element: str = "disp",
+    pallets: str = "friction",
 ) -> OpenSeesResponse:
     """Time history of ``model`` under ``record`` (a seisrack Record) in OpenSees.
 
     The analysis runs on ``dt`` (record.dt must be a whole multiple of it, as in seisrack)
-    for the record's duration; the outputs are on that grid.
+    for the record's duration; the outputs are on that grid. Records every history (one
+    Python call per node and step): for speed on large racks see ``scale_opensees.py``.
     """
     ops = _ops()
     t0 = time.perf_counter()
-    rack = build(model, mu=mu, k_init=k_init, element=element)
+    rack = build(model, mu=mu, k_init=k_init, element=element, pallets=pallets)
     ag = np.asarray(record.accel, dtype=float)
-    ops.timeSeries("Path", 1, "-dt", float(record.dt), "-values", *ag.tolist())
-    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
-    ops.constraints("Transformation")
-    ops.numberer("RCM")
-    ops.system("BandGeneral")
-    ops.integrator("Newmark", 0.5, 0.25)
-    _set_solver("Newton", tol, max_iter)
-    ops.analysis("Transient")
+    setup_analysis(ag, float(record.dt), tol=tol, max_iter=max_iter)
     build_time = time.perf_counter() - t0
 
     k = round(record.dt / dt)
@@ -317,33 +397,26 @@ def run(
     pb = [int(n) for n in rack.pallet_beam_node]
     pn = [int(n) for n in rack.pallet_node]
     pe = [int(e) for e in rack.pallet_element]
+    pm = [float(x) for x in model.pallet_mass]
     nodeDisp, nodeAccel, eleResponse = ops.nodeDisp, ops.nodeAccel, ops.eleResponse
 
     failed = retried = 0
     t1 = time.perf_counter()
     for step in range(1, n_steps + 1):
-        ok = ops.analyze(1, dt)
-        if ok != 0:
-            retried += 1
-            for n_sub, algo in ((10, "Newton"), (100, "Newton"), (10, "ModifiedNewton"),
-                                (10, "KrylovNewton")):
-                _set_solver(algo, tol, max_iter * 4)
-                ok = _substeps(step * dt, n_sub, dt)
-                if ok == 0:
-                    break
-            if ok != 0:
-                failed += 1
-                _set_solver("FixedNumIter", tol, max_iter)
-                _substeps(step * dt, 10, dt)
-            _set_solver("Newton", tol, max_iter)
+        outcome = advance(step * dt, dt, tol, max_iter)
+        retried += outcome != STEP_OK
+        failed += outcome == STEP_FAILED
         for lv, nodes in enumerate(level_nodes):
             disp[step, lv] = sum(nodeDisp(n, 1) for n in nodes) / len(nodes)
             acc[step, lv] = sum(nodeAccel(n, 1) for n in nodes) / len(nodes) + ag_grid[step]
         for j in range(m):
             slide[step, j] = nodeDisp(pn[j], 1) - nodeDisp(pb[j], 1)
-            # basic force of the zeroLength = k (u_pallet - u_beam) = force ON the beam;
-            # the beam pushes the pallet with the opposite force.
-            fric[step, j] = -eleResponse(pe[j], "basicForce")[0]
+            if pe[j] < 0:  # rigid: the force that accelerates the pallet with its node
+                fric[step, j] = pm[j] * (nodeAccel(pn[j], 1) + ag_grid[step])
+            else:
+                # basic force of the zeroLength = k (u_pallet - u_beam) = force ON the beam;
+                # the beam pushes the pallet with the opposite force.
+                fric[step, j] = -eleResponse(pe[j], "basicForce")[0]
     analysis_time = time.perf_counter() - t1
     ops.wipe()
     return OpenSeesResponse(
@@ -358,7 +431,7 @@ def run(
             "constraints": "Transformation", "geomTransf": "Linear",
             "element": ("dispBeamColumn, Elastic section, Legendre 3, -cMass"
                         if element == "disp" else "elasticBeamColumn -cMass"),
-            "friction": "zeroLength ElasticPP",
+            "friction": "zeroLength ElasticPP" if pallets == "friction" else "rigid (equalDOF)",
             "rayleigh": list(model.damping_coefficients),
         },
     )
