@@ -16,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.analysis.peaks import PeakTracker, connection_moment, rack_operators
 from seisrack.dynamics import Event, Sliders, TimeHistory, simulate
+from seisrack.dynamics.basis import Basis
 from seisrack.errors import InputError
-from seisrack.fe.recovery import base_reactions, upright_moments
 from seisrack.model.frame_model import FrameModel
 from seisrack.motion.records import Record
 
@@ -45,6 +46,10 @@ class RackResponse:
     upright_moment_base: (n_t, n_upright) [N·m]; upright_moment_connection: (n_t, n_upright,
         n_level) [N·m] largest-magnitude end moment of the upright segments at each connection.
     pallet_sliding: (n_t, m) [m] each pallet relative to its beam; pallet_friction: (n_t, m) [N].
+
+    The histories hold the samples the run kept (``run_rack(save_every=...)``; ``t`` gives
+    their times). ``full_peaks`` holds the peaks over every analysis step (always computed);
+    the peak methods below read it, so decimating the histories never changes a peak.
     """
 
     t: np.ndarray
@@ -73,6 +78,7 @@ class RackResponse:
     history: TimeHistory = field(repr=False)
     rigid_beam_acceleration_peak: np.ndarray | None = None
     beam_acceleration_raw: np.ndarray | None = None
+    full_peaks: dict[str, Any] | None = None
 
     # ------------------------------------------------------------------ derived results
     @property
@@ -89,7 +95,14 @@ class RackResponse:
         """(m,) [m] peak |sliding| of each pallet."""
         if self.n_pallets == 0:
             return np.zeros(0)
-        return np.max(np.abs(self.pallet_sliding), axis=0)
+        hi, lo = self._sliding_extremes()
+        return np.maximum(hi, -lo)
+
+    def _sliding_extremes(self) -> tuple[np.ndarray, np.ndarray]:
+        """(m,), (m,) [m] largest and smallest sliding over every analysis step."""
+        if self.full_peaks is not None:
+            return self.full_peaks["sliding_max"], self.full_peaks["sliding_min"]
+        return np.max(self.pallet_sliding, axis=0), np.min(self.pallet_sliding, axis=0)
 
     def pallet_residual(self) -> np.ndarray:
         """(m,) [m] sliding at the end of the record."""
@@ -101,8 +114,9 @@ class RackResponse:
         """(m,) largest ratio of sliding to the free distance on the side it slid towards."""
         if self.n_pallets == 0:
             return np.zeros(0)
-        pos = np.max(self.pallet_sliding, axis=0).clip(0.0)
-        neg = (-np.min(self.pallet_sliding, axis=0)).clip(0.0)
+        hi, lo = self._sliding_extremes()
+        pos = hi.clip(0.0)
+        neg = (-lo).clip(0.0)
         return np.maximum(_ratio(pos, self.pallet_limit_pos), _ratio(neg, self.pallet_limit_neg))
 
     def pallets_at_risk(self) -> list[int]:
@@ -119,7 +133,7 @@ class RackResponse:
         taken from the companion run with rigidly held pallets (what a designer computes without
         a sliding model), and also reported for this run.
         """
-        alpha_run = np.max(np.abs(self.beam_acceleration), axis=0) / self.g
+        alpha_run = self._level_peak("beam_acceleration") / self.g
         alpha_rigid = (
             self.rigid_beam_acceleration_peak / self.g
             if self.rigid_beam_acceleration_peak is not None
@@ -131,6 +145,8 @@ class RackResponse:
         unsafe = slid & ~predicted
         return {
             "rule": "no sliding if mu_static >= alpha = peak beam acceleration / g",
+            "alpha_source": "rigid companion run" if self.rigid_beam_acceleration_peak
+            is not None else "this run (run_rack(rigid_companion=True) for rigid pallets)",
             "alpha_rigid": alpha_rigid.tolist(),
             "alpha_this_run": alpha_run.tolist(),
             "predicted_sliding": predicted.tolist(),
@@ -141,17 +157,24 @@ class RackResponse:
 
     def peaks(self) -> dict[str, Any]:
         """Peak values (JSON-ready), the issue #5 ``--json`` schema plus extra fields."""
-        disp = np.max(np.abs(self.beam_displacement), axis=0)
-        acc = np.max(np.abs(self.beam_acceleration), axis=0)
-        force = np.max(np.abs(self.contact_force), axis=0)
-        mb = np.max(np.abs(self.upright_moment_base))
-        conn = self.upright_moment_connection
-        mc = np.max(np.abs(conn)) if conn.size else 0.0
+        disp = self._level_peak("beam_displacement")
+        acc = self._level_peak("beam_acceleration")
+        force = self._level_peak("contact_force")
+        fp = self.full_peaks
+        if fp is not None:
+            mb, mc = fp["upright_moment_base"], fp["upright_moment_connection"]
+            total, shear = fp["total_friction_force"], fp["base_shear"]
+        else:
+            mb = np.max(np.abs(self.upright_moment_base))
+            conn = self.upright_moment_connection
+            mc = np.max(np.abs(conn)) if conn.size else 0.0
+            total = np.max(np.abs(self.contact_force.sum(axis=1)))
+            shear = np.max(np.abs(self.base_shear))
         return {
             "beam_displacement_m": float(disp.max()),
             "beam_acceleration_m_s2": float(acc.max()),
-            "total_friction_force_N": float(np.max(np.abs(self.contact_force.sum(axis=1)))),
-            "base_shear_N": float(np.max(np.abs(self.base_shear))),
+            "total_friction_force_N": float(total),
+            "base_shear_N": float(shear),
             "upright_moment_base_Nm": float(mb),
             "upright_moment_connection_Nm": float(mc),
             "pallet_sliding_m": self.pallet_peak_sliding().tolist(),
@@ -162,6 +185,12 @@ class RackResponse:
                 "contact_force_N": force.tolist(),
             },
         }
+
+    def _level_peak(self, name: str) -> np.ndarray:
+        """(n_level,) peak |value| of a per-level history over every analysis step."""
+        if self.full_peaks is not None:
+            return np.asarray(self.full_peaks[name])
+        return np.max(np.abs(getattr(self, name)), axis=0)
 
     def summary(self) -> dict[str, Any]:
         """Everything the CLI prints with ``--json``."""
@@ -244,10 +273,14 @@ def run_rack(
     vertical: Record | None = None,
     free_vibration: float = 0.0,
     backend: str = "auto",
-    rigid_companion: bool = True,
+    rigid_companion: bool = False,
     progress: Callable[[int], None] | None = None,
     throw: bool = True,
     method: str = "auto",
+    basis: str | Basis = "auto",
+    save_every: int | None = 1,
+    track_energy: bool = True,
+    max_memory: float | None = None,
 ) -> RackResponse:
     """Time history of ``model`` under the horizontal ground acceleration ``record``.
 
@@ -255,11 +288,17 @@ def run_rack(
         ≤ 5 ms). vertical: optional vertical ground acceleration (same dt and length); the
         pallets' normal forces become m (g + a_v) and the structure is loaded vertically.
     free_vibration: seconds of zero ground motion appended after the record.
-    rigid_companion: also run the rack with rigidly held pallets (for the simplified check).
+    rigid_companion: also run the rack with rigidly held pallets, so that the simplified
+        check's alpha is the designer's (rigid) one; off by default (it costs a second run):
+        the check then uses this run's beam accelerations.
     progress: called with the number of analysis steps just completed, an increment (as
         ``tqdm.update`` expects), after each chunk of steps of the main run.
     method: time integration of :func:`seisrack.dynamics.simulate` ("auto", "exact" or
-        "newmark").
+        "newmark"); basis: its ``basis`` ("auto": every mode up to 300 DOFs, a reduced
+        load-dependent Ritz basis above).
+    save_every: keep every k-th sample of the histories (``None``: first and last only, for
+        studies); peaks are always taken over every step. max_memory: bytes the histories may
+        take (default 80 % of the available memory); a longer run is refused up front.
     """
     if not isinstance(record, Record):
         raise InputError("record", type(record).__name__, "a seisrack.motion.Record")
@@ -294,24 +333,52 @@ def run_rack(
     sliders = Sliders(
         model.pallet_dof, model.pallet_mass, model.pallet_mu_static, model.pallet_mu_dynamic
     )
-    hist = simulate(
-        model.M, model.C, model.K, sliders, dt=h, ground_accel=ag, influence=model.r_x,
-        vertical_accel=av, vertical_influence=None if av is None else model.r_y, g=model.g,
-        backend=backend, throw=throw, progress=progress, method=method,
-    )
+    mats = (model.M_sparse, model.C_sparse, model.K_sparse)
+    common = dict(dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
+                  vertical_influence=None if av is None else model.r_y, g=model.g,
+                  backend=backend, throw=throw, method=method)
+    # the basis is built once and shared with the companion run
+    bas = basis if isinstance(basis, Basis) else _basis_for(model, sliders, basis, av)
+    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+    pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
+    P = bas.phi[model.pallet_dof, :]  # (m, r) support of each pallet
+    ops = rack_operators(model, bas.phi)
+    # the smoothing of Newmark's period-2h acceleration residue is decided after the run;
+    # track both and keep the one that applies
+    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s) for s in (False, True)}
+
+    def on_chunk(c) -> None:  # noqa: ANN001
+        for t in trackers.values():
+            t(c)
+
+    hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
+                    save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
+                    max_memory=max_memory)
+    peaks = trackers[hist.method == "newmark"].result()
     rigid_peak = None
     if rigid_companion and model.n_pallets:
-        rigid = simulate(
-            model.M, model.C, model.K,
-            Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU),
-            dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
-            vertical_influence=None if av is None else model.r_y, g=model.g, backend=backend,
-            throw=throw, track_energy=False, method=method,
-        )
-        rigid_peak = np.array([
-            np.max(np.abs(rigid.dof_response(d, "a").mean(axis=1) + ag)) for d in model.level_dofs
-        ])
-    return _response(model, hist, ag, h, record.name, rigid_peak)
+        rig = PeakTracker(ops, P, pallet_level, ag, h, smooth=False)
+        rigid_sl = Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU)
+        common["method"] = "exact" if hist.method == "exact" else method
+        simulate(*mats, rigid_sl, **common, basis=bas, save_every=None, on_chunk=rig,
+                 track_energy=False)
+        rigid_peak = rig.result()["beam_acceleration"]
+    return _response(model, hist, ag, h, record.name, rigid_peak, ops, pallet_level, peaks)
+
+
+def _basis_for(model: FrameModel, sliders: Sliders, basis: str, av) -> Basis:  # noqa: ANN001
+    from seisrack.dynamics.basis import full_basis, reduced_basis
+    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF
+
+    if basis not in ("auto", "full", "reduced"):
+        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    if basis == "full" or (basis == "auto" and model.n_dof <= AUTO_FULL_MAX_DOF):
+        return full_basis(model.M_sparse, model.K_sparse)
+    loads = [model.total_mass_sparse() @ model.r_x]
+    if av is not None:
+        loads.append(model.M_sparse @ model.r_y)
+    return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
+                         np.column_stack(loads))
 
 
 def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
@@ -334,36 +401,32 @@ def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
 
 def _response(
     model: FrameModel, hist: TimeHistory, ag: np.ndarray, h: float, name: str,
-    rigid_peak: np.ndarray | None,
+    rigid_peak: np.ndarray | None, ops, pallet_level: np.ndarray, peaks: dict,  # noqa: ANN001
 ) -> RackResponse:
-    U = hist.u
-    disp = np.stack([U[:, d].mean(axis=1) for d in model.level_dofs], axis=1)
-    acc_raw = np.stack([hist.a[:, d].mean(axis=1) + ag for d in model.level_dofs], axis=1)
-    vel = np.stack([hist.v[:, d].mean(axis=1) for d in model.level_dofs], axis=1)
-    acc = smoothed_acceleration(vel, acc_raw - ag[:, None], h) + ag[:, None]
-    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
-    pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
+    idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
+    agk = ag[idx]
+    disp = hist.q @ ops.level
+    vel = hist.qd @ ops.level
+    acc_raw = hist.qdd @ ops.level + agk[:, None]
+    contiguous = idx.shape[0] == ag.shape[0]
+    if hist.method == "newmark" and contiguous:
+        acc = smoothed_acceleration(vel, acc_raw - agk[:, None], h) + agk[:, None]
+    else:  # exact propagators leave no period-2h residue; decimated samples are not smoothed
+        acc = acc_raw
     n_level = len(model.level_dofs)
-    force = np.zeros((U.shape[0], n_level))
-    for j, lv in enumerate(pallet_level):
-        force[:, lv] += hist.friction[:, j]
+    force = np.zeros((idx.shape[0], n_level))
+    np.add.at(force.T, pallet_level, hist.friction.T)
     # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
     # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
-    a1 = float(model.damping_coefficients[1])
-    # Reactions and moments are linear in U: evaluate the recovery once on the identity to get
-    # the operators, then apply them to the whole history with one matrix product each.
-    eye = np.eye(model.n_dof)
-    shear_op = -base_reactions(model, eye)[..., 0].sum(axis=-1)  # (n_dof,)
-    mom_eye = upright_moments(model, eye)
-    base_shear = (U + a1 * hist.v) @ shear_op
-    n_t = U.shape[0]
-    mom_base = U @ mom_eye.base
-    below = (U @ mom_eye.below.reshape(model.n_dof, -1)).reshape((n_t, *mom_eye.below.shape[1:]))
-    above = (U @ mom_eye.above.reshape(model.n_dof, -1)).reshape((n_t, *mom_eye.above.shape[1:]))
-    conn = np.where(np.abs(below) >= np.abs(above), below, above)
+    base_shear = hist.q @ ops.shear + ops.a1 * (hist.qd @ ops.shear)
+    n_t = idx.shape[0]
+    mom_base = hist.q @ ops.base_moment
+    shape = (n_t, ops.n_upright, ops.n_level)
+    conn = connection_moment((hist.q @ ops.below).reshape(shape),
+                             (hist.q @ ops.above).reshape(shape))
     return RackResponse(
         t=hist.t,
-        ground_accel=ag,
+        ground_accel=agk,
         beam_displacement=disp,
         beam_acceleration=acc,
         beam_acceleration_raw=acc_raw,
@@ -388,4 +451,5 @@ def _response(
         status=hist.status,
         history=hist,
         rigid_beam_acceleration_peak=rigid_peak,
+        full_peaks=peaks,
     )

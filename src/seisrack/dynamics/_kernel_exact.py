@@ -1,7 +1,7 @@
 """Exact-propagator stick–slip kernel (source shared by the numba and pure-Python backends).
 
 Loaded after ``_kernel.py`` in the same namespace (see :mod:`seisrack.dynamics.kernels`), so it
-reuses ``_solve``, ``_mv``, ``_interp``, ``_event_values`` and ``_consistent`` from there.
+reuses ``_mv``, ``_interp`` and ``_event_values`` from there.
 
 Between two contact events the system is linear and time-invariant: the structure plus the
 masses of the sliders that are stuck on it (they move with their support node), loaded by
@@ -33,7 +33,6 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         STATUS_NONFINITE,
         STATUS_OK,
         STATUS_SUBSTEP_LIMIT,
-        _consistent,
         _event_values,
         _interp,
         _mv,
@@ -101,50 +100,152 @@ def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
 
 
 @_JIT
-def _build_config(slot, key, w2, cd, a1, fixed, P, mass, pat, dt,
-                  c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E):
-    """Modes of the structure with the sliders of ``key`` stuck on it, and derived operators."""
-    n = w2.shape[0]
-    m = P.shape[0]
-    Ms = np.eye(n)
-    any_stuck = False
+def _rank1(Ms, p, c):
+    """Ms += c p pᵀ (a slider of mass c sticking, or -c unsticking)."""
+    r = p.shape[0]
+    for i in range(r):
+        pi = c * p[i]
+        if pi != 0.0:
+            for k in range(r):
+                Ms[i, k] += pi * p[k]
+
+
+@_JIT
+def _cfg_mass(P, mass, key, Ms):
+    """Ms = I + P_Sᵀ diag(m_S) P_S for the stuck set ``key`` (from scratch)."""
+    r = P.shape[1]
+    for i in range(r):
+        for k in range(r):
+            Ms[i, k] = 0.0
+        Ms[i, i] = 1.0
+    for j in range(P.shape[0]):
+        if key[j]:
+            _rank1(Ms, P[j], mass[j])
+
+
+@_JIT
+def _spd_solve(A, b, x):
+    """x = A⁻¹ b for a small symmetric positive-definite A (Cholesky)."""
+    r = A.shape[0]
+    L = np.linalg.cholesky(A)
+    for i in range(r):
+        acc = b[i]
+        for k in range(i):
+            acc -= L[i, k] * x[k]
+        x[i] = acc / L[i, i]
+    for i in range(r - 1, -1, -1):
+        acc = x[i]
+        for k in range(i + 1, r):
+            acc -= L[k, i] * x[k]
+        x[i] = acc / L[i, i]
+
+
+@_JIT
+def _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag, pext, N,
+                    stuck, sig, cand, forced, qdd, wdd, lam):
+    """Decide the contact state at an instant and compute consistent accelerations.
+
+    Same decision rule as ``_consistent`` (stick every candidate, release the most overloaded
+    stuck slider one at a time), solved in the structure's coordinates: the stuck sliders'
+    masses join the configuration mass ``I + P_Sᵀ m_S P_S`` (rank-one changes from ``Ms_key``,
+    the mass of the stuck set ``key``), so the cost is O(m r + r³), never O(m²).
+    """
+    r = w2.shape[0]
+    m = mass.shape[0]
+    base = np.empty(r)
+    for i in range(r):
+        base[i] = pext[i] - cd[i] * qd[i] - w2[i] * q[i]
     for j in range(m):
+        if cand[j]:
+            stuck[j] = True
+        elif forced[j]:
+            stuck[j] = False
+    Mt = Ms_key.copy()
+    for j in range(m):
+        if on_struct[j] and stuck[j] != key[j]:
+            _rank1(Mt, P[j], mass[j] if stuck[j] else -mass[j])
+    rhs = np.empty(r)
+    for _it in range(2 * m + 2):
+        for i in range(r):
+            rhs[i] = base[i]
+        for j in range(m):
+            if stuck[j]:
+                f = -mass[j] * ag
+            else:
+                lam[j] = -mud[j] * N[j] * sig[j]
+                f = -lam[j]
+            if on_struct[j] and f != 0.0:
+                for i in range(r):
+                    rhs[i] += P[j, i] * f
+        _spd_solve(Mt, rhs, qdd)
+        for j in range(m):
+            if stuck[j]:
+                acc = 0.0
+                if on_struct[j]:
+                    for i in range(r):
+                        acc += P[j, i] * qdd[i]
+                lam[j] = mass[j] * (acc + ag)
+        worst = -1
+        worst_ratio = 1.0 + 1e-12
+        for j in range(m):
+            if stuck[j] and not forced[j]:
+                cap = mus[j] * N[j]
+                if cap <= 0.0:
+                    ratio = np.inf if lam[j] != 0.0 else 0.0
+                else:
+                    ratio = abs(lam[j]) / cap
+                if ratio > worst_ratio:
+                    worst_ratio = ratio
+                    worst = j
+        if worst < 0:
+            break
+        stuck[worst] = False
+        sig[worst] = -1.0 if lam[worst] > 0.0 else 1.0
+        if on_struct[worst]:
+            _rank1(Mt, P[worst], -mass[worst])
+    for j in range(m):
+        wdd[j] = -ag + lam[j] / mass[j]
+
+
+@_JIT
+def _build_config(slot, key, Ms, w2, cd, a1, fixed, pat, dt,
+                  c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E):
+    """Modes of the structure with the sliders of ``key`` stuck on it (configuration mass
+    ``Ms``), and the operators derived from them. Cost O(r³), independent of the slider count."""
+    n = w2.shape[0]
+    any_stuck = False
+    for j in range(key.shape[0]):
         if key[j]:
             any_stuck = True
-            for i in range(n):
-                pji = mass[j] * P[j, i]
-                if pji != 0.0:
-                    for k in range(n):
-                        Ms[i, k] += pji * P[j, k]
     if fixed or not any_stuck:
         psi = np.eye(n)
         nu2 = w2.copy()
         cc = cd.copy()
+        psitm = np.eye(n)
     else:
         L = np.linalg.cholesky(Ms)
         Linv = np.linalg.inv(L)
-        A = Linv @ np.diag(w2) @ Linv.T
+        A = (Linv * w2) @ Linv.T
         A = 0.5 * (A + A.T)
         nu2, Y = np.linalg.eigh(A)
         psi = Linv.T @ Y
         cc = a1 * nu2
+        psitm = psi.T @ Ms
     scale = max(np.max(np.abs(nu2)), 1e-300)
     for k in range(n):
         if nu2[k] < 1e-14 * scale:
             nu2[k] = 1e-14 * scale
     c_psi[slot] = psi
-    c_psitm[slot] = psi.T @ Ms
+    c_psitm[slot] = psitm
     c_nu2[slot] = nu2
     c_cc[slot] = cc
-    c_R[slot] = P @ psi
     c_gpat[slot] = psi.T @ pat.T
-    c_gsl[slot] = psi.T @ P.T
     _mode_matrices(nu2, cc, dt, c_E[slot])
 
 
 @_JIT
-def _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P, mass, pat,
-                 dt, c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E):
+def _find_config(key, Ms, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, pat, dt,
+                 c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E):
     """Slot of the configuration ``key`` in the cache (built on a miss; LRU eviction)."""
     cap = cfg_key.shape[0]
     m = key.shape[0]
@@ -167,8 +268,8 @@ def _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P
         if cfg_stamp[s] < oldest:
             oldest = cfg_stamp[s]
             slot = s
-    _build_config(slot, key, w2, cd, a1, fixed, P, mass, pat, dt,
-                  c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl, c_E)
+    _build_config(slot, key, Ms, w2, cd, a1, fixed, pat, dt,
+                  c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E)
     for j in range(m):
         cfg_key[slot, j] = key[j]
     cfg_valid[slot] = True
@@ -177,17 +278,12 @@ def _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P
 
 
 @_JIT
-def _loads(gpat, gsl, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, out):
-    """Constrained modal load at one instant: Ψᵀ(p - P_Sᵀ m_S a_g - P_Fᵀ λ_F)."""
-    n = out.shape[0]
-    npat = series_t.shape[0]
-    m = mass.shape[0]
-    for k in range(n):
-        acc = 0.0
-        for c in range(npat):
-            acc += gpat[k, c] * series_t[c]
-        out[k] = acc
-    for j in range(m):
+def _slider_load(P, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, fq):
+    """Structure-coordinate load of the sliders: -P_Sᵀ m_S a_g - P_Fᵀ λ_F."""
+    r = fq.shape[0]
+    for i in range(r):
+        fq[i] = 0.0
+    for j in range(mass.shape[0]):
         if not on_struct[j]:
             continue
         if stuck[j]:
@@ -195,34 +291,54 @@ def _loads(gpat, gsl, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, out
         else:
             f = mud[j] * N_t[j] * sig[j]  # -λ_j with λ_j = -mu_d N σ
         if f != 0.0:
-            for k in range(n):
-                out[k] += gsl[k, j] * f
+            for i in range(r):
+                fq[i] += P[j, i] * f
 
 
 @_JIT
-def _trial_exact(h, Eh, psi, nu2, cc, R, gpat, gsl, mass, mud, on_struct, stuck, sig,
+def _loads(psi, gpat, P, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, fq, out):
+    """Constrained modal load at one instant: Ψᵀ(p - P_Sᵀ m_S a_g - P_Fᵀ λ_F)."""
+    n = out.shape[0]
+    npat = series_t.shape[0]
+    _slider_load(P, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, fq)
+    for k in range(n):
+        acc = 0.0
+        for c in range(npat):
+            acc += gpat[k, c] * series_t[c]
+        for i in range(n):
+            acc += psi[i, k] * fq[i]
+        out[k] = acc
+
+
+@_JIT
+def _trial_exact(h, Eh, psi, nu2, cc, P, gpat, mass, mud, on_struct, stuck, sig,
                  eta0, etad0, w0, wd0, ser0, ser1, ag0, ag1, N0, N1, g0, g1,
-                 eta1, etad1, w1, wd1, lam1, s1, etadd):
+                 eta1, etad1, w1, wd1, lam1, s1, etadd, x0, x1, xd1, xdd, fq):
     """Exact step of length h in a fixed contact state (E = propagator for h)."""
     n = nu2.shape[0]
     m = mass.shape[0]
-    _loads(gpat, gsl, ser0, ag0, N0, mass, mud, stuck, sig, on_struct, g0)
-    _loads(gpat, gsl, ser1, ag1, N1, mass, mud, stuck, sig, on_struct, g1)
+    _loads(psi, gpat, P, ser0, ag0, N0, mass, mud, stuck, sig, on_struct, fq, g0)
+    _loads(psi, gpat, P, ser1, ag1, N1, mass, mud, stuck, sig, on_struct, fq, g1)
     _propagate(nu2, cc, Eh, eta0, etad0, g0, g1, h, eta1, etad1)
     for k in range(n):
         etadd[k] = g1[k] - cc[k] * etad1[k] - nu2[k] * eta1[k]
+    _mv(psi, eta0, x0)
+    _mv(psi, eta1, x1)
+    _mv(psi, etad1, xd1)
+    _mv(psi, etadd, xdd)
     for j in range(m):
         if stuck[j]:
             d0 = 0.0
             d1 = 0.0
             v1 = 0.0
             a1_ = 0.0
-            for k in range(n):
-                r = R[j, k]
-                d0 += r * eta0[k]
-                d1 += r * eta1[k]
-                v1 += r * etad1[k]
-                a1_ += r * etadd[k]
+            if on_struct[j]:
+                for i in range(n):
+                    p = P[j, i]
+                    d0 += p * x0[i]
+                    d1 += p * x1[i]
+                    v1 += p * xd1[i]
+                    a1_ += p * xdd[i]
             w1[j] = w0[j] + (d1 - d0)
             wd1[j] = v1
             lam1[j] = mass[j] * (a1_ + ag1)
@@ -235,8 +351,9 @@ def _trial_exact(h, Eh, psi, nu2, cc, R, gpat, gsl, mass, mud, on_struct, stuck,
             wd1[j] = wd0[j] + 0.5 * h * (a0 + a1_)
             w1[j] = w0[j] + h * wd0[j] + h * h * (2.0 * a0 + a1_) / 6.0
             v1 = 0.0
-            for k in range(n):
-                v1 += R[j, k] * etad1[k]
+            if on_struct[j]:
+                for i in range(n):
+                    v1 += P[j, i] * xd1[i]
             s1[j] = wd1[j] - v1
 
 
@@ -270,8 +387,8 @@ def _equilibrium_qdd(w2, cd, P, pext_t, q, qd, lam, qdd):
 
 
 @_JIT
-def _energy_substep(h, Eh, nu2, cc, R, eta0, etad0, g0, g1, mass, mud, on_struct, stuck, sig,
-                    w0, wd0, ag0, ag1, N0, N1, out):
+def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_struct, stuck,
+                    sig, w0, wd0, ag0, ag1, N0, N1, out, fq, f0, fs):
     """Input, damping and friction work over a sub-step, in closed form.
 
     Per mode (η̈ + c η̇ + ν² η = g0 + s τ, particular part A + B τ, homogeneous part y):
@@ -287,7 +404,32 @@ def _energy_substep(h, Eh, nu2, cc, R, eta0, etad0, g0, g1, mass, mud, on_struct
     e_in = 0.0
     e_d = 0.0
     e_f = 0.0
-    # per-slider sliding-force slopes on the structure: λ_j(τ) = lam0 + lam_s τ
+    # sliding forces on the structure, λ_j(τ) = l0_j + ls_j τ, as modal loads f0 + fs τ
+    r_ = fq.shape[0]
+    for i in range(r_):
+        fq[i] = 0.0
+    for j in range(m):
+        if on_struct[j] and not stuck[j]:
+            l0 = -mud[j] * N0[j] * sig[j]
+            for i in range(r_):
+                fq[i] += P[j, i] * l0
+    for k in range(n):
+        acc = 0.0
+        for i in range(r_):
+            acc += psi[i, k] * fq[i]
+        f0[k] = acc
+    for i in range(r_):
+        fq[i] = 0.0
+    for j in range(m):
+        if on_struct[j] and not stuck[j]:
+            ls = -mud[j] * (N1[j] - N0[j]) * sig[j] / h
+            for i in range(r_):
+                fq[i] += P[j, i] * ls
+    for k in range(n):
+        acc = 0.0
+        for i in range(r_):
+            acc += psi[i, k] * fq[i]
+        fs[k] = acc
     for k in range(n):
         c = cc[k]
         w = nu2[k]
@@ -316,15 +458,9 @@ def _energy_substep(h, Eh, nu2, cc, R, eta0, etad0, g0, g1, mass, mud, on_struct
             e_d += (c * B * B * h + 2.0 * c * B * (y1 - y0)
                     + cw11 * y0 * y0 + 2.0 * cw12 * y0 * yd0 + cw22 * yd0 * yd0)
         # sliding forces on the structure: their power leaves the input, enters friction
-        for j in range(m):
-            if on_struct[j] and not stuck[j]:
-                r = R[j, k]
-                if r != 0.0:
-                    l0 = -mud[j] * N0[j] * sig[j]
-                    ls = (-mud[j] * N1[j] * sig[j] - l0) / h
-                    work = r * (l0 * d_eta + ls * mom)  # ∫ λ_j v_support dτ
-                    e_in += work
-                    e_f += work
+        work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
+        e_in += work
+        e_f += work
     for j in range(m):
         if stuck[j]:
             continue  # stuck on the structure: inside g; stuck on the ground: no motion
@@ -376,15 +512,6 @@ def run_kernel_exact(
         for i in range(n):
             if P[j, i] != 0.0:
                 on_struct[j] = True
-    B = np.zeros((m, m))
-    for a in range(m):
-        for b in range(m):
-            acc = 0.0
-            for i in range(n):
-                acc += P[a, i] * P[b, i]
-            B[a, b] = acc
-        B[a, a] += 1.0 / mass[a]
-    Cq = np.zeros((1, 1))
     # configuration cache
     cap = max(cache_size, 1)
     cfg_key = np.zeros((cap, m), dtype=np.bool_)
@@ -394,9 +521,7 @@ def run_kernel_exact(
     c_psitm = np.zeros((cap, n, n))
     c_nu2 = np.zeros((cap, n))
     c_cc = np.zeros((cap, n))
-    c_R = np.zeros((cap, m, n))
     c_gpat = np.zeros((cap, n, npat))
-    c_gsl = np.zeros((cap, n, m))
     c_E = np.zeros((cap, n, 4))
     n_built = 0
     stamp = 0
@@ -427,8 +552,13 @@ def run_kernel_exact(
         E_damp = 0.0
         E_fric = 0.0
     cand = stuck.copy()
-    _consistent(w2, cd, Cq, True, P, B, mass, mus, mud, q, qd, ag[0], pext[0], N[0],
-                stuck, sig, cand, forced, qdd, wdd, lam)
+    # configuration mass of the stuck set ``key``, kept up to date by rank-one changes
+    Ms_key = np.empty((n, n))
+    _cfg_key(stuck, on_struct, key)
+    _cfg_mass(P, mass, key, Ms_key)
+    n_rank1 = 0
+    _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag[0], pext[0],
+                    N[0], stuck, sig, cand, forced, qdd, wdd, lam)
     n_ev = 0
     status = STATUS_OK
     for j in range(m):
@@ -439,9 +569,9 @@ def run_kernel_exact(
                 ev_kind[n_ev] = KIND_SLIP
             n_ev += 1
     _cfg_key(stuck, on_struct, key)
-    slot, built = _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, P,
-                               mass, pat, dt, c_psi, c_psitm, c_nu2, c_cc, c_R, c_gpat, c_gsl,
-                               c_E)
+    _cfg_mass(P, mass, key, Ms_key)
+    slot, built = _find_config(key, Ms_key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1,
+                               fixed, pat, dt, c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E)
     n_built += 1
     eta = np.empty(n)
     etad = np.empty(n)
@@ -477,6 +607,13 @@ def run_kernel_exact(
     vn = np.empty(m)
     N0 = np.empty(m)
     N_e = np.empty(m)
+    x0 = np.empty(n)
+    x1 = np.empty(n)
+    xd1 = np.empty(n)
+    xdd = np.empty(n)
+    fq = np.empty(n)
+    f0 = np.empty(n)
+    fs = np.empty(n)
     n_sub_total = 0
     _mv(P, qd, vn)
     for j in range(m):
@@ -514,9 +651,8 @@ def run_kernel_exact(
             hrem = (1.0 - tau) * dt
             nu2 = c_nu2[slot]
             cc = c_cc[slot]
-            R = c_R[slot]
+            psi = c_psi[slot]
             gpat = c_gpat[slot]
-            gsl = c_gsl[slot]
             for c in range(npat):
                 ser0[c] = _interp(series[step, c], series[step + 1, c], tau)
                 ser1[c] = series[step + 1, c]
@@ -529,9 +665,9 @@ def run_kernel_exact(
             else:
                 _mode_matrices(nu2, cc, hrem, Esub)
                 Eh = Esub
-            _trial_exact(hrem, Eh, c_psi[slot], nu2, cc, R, gpat, gsl, mass, mud, on_struct,
+            _trial_exact(hrem, Eh, psi, nu2, cc, P, gpat, mass, mud, on_struct,
                          stuck, sig, eta, etad, w, wd, ser0, ser1, ag0, ag1, N0, N[step + 1],
-                         g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd)
+                         g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd, x0, x1, xd1, xdd, fq)
             any_ev = False
             for j in range(m):
                 n1 = N[step + 1, j]
@@ -596,9 +732,10 @@ def run_kernel_exact(
                     for j in range(m):
                         N_e[j] = _interp(N[step, j], N[step + 1, j], frac_end)
                     _mode_matrices(nu2, cc, hsub, Esub)
-                    _trial_exact(hsub, Esub, c_psi[slot], nu2, cc, R, gpat, gsl, mass, mud,
+                    _trial_exact(hsub, Esub, psi, nu2, cc, P, gpat, mass, mud,
                                  on_struct, stuck, sig, eta, etad, w, wd, ser0, sere, ag0, ag_e,
-                                 N0, N_e, g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd)
+                                 N0, N_e, g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd,
+                                 x0, x1, xd1, xdd, fq)
                     _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
                     viol_try = False
                     for j in range(m):
@@ -652,8 +789,9 @@ def run_kernel_exact(
                 ag_b = _interp(ag[step], ag[step + 1], frac_hi)
                 for j in range(m):
                     N_e[j] = _interp(N[step, j], N[step + 1, j], frac_hi)
-                _energy_substep(h_acc, Eacc, nu2, cc, R, eta, etad, g0, g1, mass, mud,
-                                on_struct, stuck, sig, w, wd, ag0, ag_b, N0, N_e, ework)
+                _energy_substep(h_acc, Eacc, psi, nu2, cc, P, eta, etad, g0, g1, mass, mud,
+                                on_struct, stuck, sig, w, wd, ag0, ag_b, N0, N_e, ework,
+                                fq, f0, fs)
                 E_in += ework[0]
                 E_damp += ework[1]
                 E_fric += ework[2]
@@ -691,8 +829,8 @@ def run_kernel_exact(
                     if e_try[j] > -1e-9 * vs:
                         cand[j] = True
                         wd[j] = vn[j]
-            _consistent(w2, cd, Cq, True, P, B, mass, mus, mud, q, qd, ag_e, pe_t, N_e,
-                        stuck, sig, cand, forced, qdd, wdd, lam)
+            _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag_e,
+                            pe_t, N_e, stuck, sig, cand, forced, qdd, wdd, lam)
             for j in range(m):
                 s[j] = wd[j] - vn[j]
                 kind = -1
@@ -714,10 +852,18 @@ def run_kernel_exact(
                     changed = True
             if changed:
                 stamp += 1
-                _cfg_key(stuck, on_struct, key)
-                slot, built = _find_config(key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd,
-                                           a1, fixed, P, mass, pat, dt, c_psi, c_psitm, c_nu2,
-                                           c_cc, c_R, c_gpat, c_gsl, c_E)
+                for j in range(m):
+                    now = stuck[j] and on_struct[j]
+                    if now != key[j]:
+                        _rank1(Ms_key, P[j], mass[j] if now else -mass[j])
+                        n_rank1 += 1
+                        key[j] = now
+                if n_rank1 > 1000:  # bound the round-off of many rank-one updates
+                    _cfg_mass(P, mass, key, Ms_key)
+                    n_rank1 = 0
+                slot, built = _find_config(key, Ms_key, cfg_key, cfg_valid, cfg_stamp, stamp,
+                                           w2, cd, a1, fixed, pat, dt, c_psi, c_psitm, c_nu2,
+                                           c_cc, c_gpat, c_E)
                 if built:
                     n_built += 1
                 _to_modal(c_psitm[slot], q, qd, eta, etad)

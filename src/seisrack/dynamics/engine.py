@@ -1,20 +1,27 @@
-"""Entry point of the stick–slip engine: validate, transform to modal coordinates, integrate.
+"""Entry point of the stick–slip engine: validate, choose a basis, integrate in chunks.
 
-The structure is linear (M, C, K); the sliders are masses resting on structural DOFs with
-Coulomb friction (paper §II–III; law as in issue #3). Each contact phase is integrated either in
-closed form with the modes of its contact configuration ("exact", when damping is classical in
-every configuration) or by Newmark average acceleration, with exact event location inside the
-step, so a step never "fails to converge". See ``docs/theory/stick_slip_engine.md``.
+The structure is linear (M, C, K; dense or scipy sparse); the sliders are masses resting on
+structural DOFs with Coulomb friction (paper §II–III; law as in issue #3). The structure is
+written in a mass-orthonormal basis (every mode, or a reduced Ritz basis for large structures,
+:mod:`seisrack.dynamics.basis`). Each contact phase is integrated either in closed form with the
+modes of its contact configuration ("exact", when damping is classical in every configuration)
+or by Newmark average acceleration, with exact event location inside the step, so a step never
+"fails to converge". See ``docs/theory/stick_slip_engine.md``.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
-import scipy.linalg
 
+from seisrack.dynamics import _inputs as chk
+from seisrack.dynamics._store import Buffers as _Buffers
+from seisrack.dynamics._store import Kept as _Kept
+from seisrack.dynamics.basis import Basis, full_basis, reduced_basis
 from seisrack.dynamics.kernels import get_kernel
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
 from seisrack.dynamics.sliders import Sliders
@@ -25,6 +32,10 @@ _LOG = logging.getLogger(__name__)
 #: cap on sub-steps (event splits) inside one time step; slip-onset chatter with mu_d = mu_s
 #: can produce dozens of micro-events in one step on multi-pallet racks
 _MAX_SUBSTEPS = 512
+#: with ``basis="auto"``, structures up to this many DOFs keep every mode
+AUTO_FULL_MAX_DOF = 300
+#: steps integrated per kernel call (bounded working memory; the state carries over exactly)
+DEFAULT_CHUNK = 20_000
 
 _STATUS = {
     0: "ok",
@@ -34,44 +45,27 @@ _STATUS = {
 }
 
 
-def _square(name: str, mat: object, n: int | None) -> np.ndarray:
-    a = np.asarray(mat, dtype=float)
-    if a.ndim == 0 and n == 1:
-        a = a.reshape(1, 1)
-    if a.ndim != 2 or a.shape[0] != a.shape[1]:
-        raise InputError(name, f"array of shape {a.shape}", "a square matrix")
-    if n is not None and a.shape[0] != n:
-        raise InputError(name, f"shape {a.shape}", f"shape ({n}, {n}) like M")
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "non-finite entries", "finite numbers")
-    return a
+class Chunk(NamedTuple):
+    """Full-rate results of one chunk of steps, handed to ``on_chunk`` (views: copy to keep).
 
+    t: (k,) [s]; q, qd, qdd: (k, r) basis coordinates; slider_u, slider_v, friction: (k, m);
+    stuck: (k, m) bool. Consecutive chunks share their boundary sample.
+    """
 
-def _series(name: str, val: object, shape: tuple[int, ...]) -> np.ndarray:
-    a = np.asarray(val, dtype=float)
-    if a.shape != shape:
-        raise InputError(name, f"array of shape {a.shape}", f"shape {shape}")
-    if not np.all(np.isfinite(a)):
-        bad = int(np.argmax(~np.isfinite(a.ravel())))
-        raise InputError(name, f"non-finite value at flat index {bad}", "finite numbers")
-    return a
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    slider_u: np.ndarray
+    slider_v: np.ndarray
+    friction: np.ndarray
+    stuck: np.ndarray
 
 
 def modal_basis(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: N803
     """Mass-normalised eigenbasis: returns (omega², Φ) with Φᵀ M Φ = I, Φᵀ K Φ = diag(omega²)."""
-    try:
-        w2, phi = scipy.linalg.eigh(K, M)
-    except np.linalg.LinAlgError as exc:
-        raise InputError(
-            "M", "not positive definite", "a symmetric positive-definite mass matrix",
-            hint="Every DOF needs mass (use a consistent mass matrix for rotations)",
-        ) from exc
-    scale = max(float(np.max(np.abs(w2))), 1e-300)
-    if np.min(w2) < -1e-9 * scale:
-        raise InputError(
-            "K", f"negative eigenvalue {np.min(w2):.3g}", "a positive semi-definite stiffness"
-        )
-    return np.clip(w2, 0.0, None), phi
+    b = full_basis(M, K)
+    return b.w2, b.phi
 
 
 def simulate(
@@ -97,13 +91,18 @@ def simulate(
     progress: Callable[[int], None] | None = None,
     chunk_steps: int | None = None,
     method: str = "auto",
+    basis: str | Basis = "auto",
+    save_every: int | None = 1,
+    on_chunk: Callable[[Chunk], None] | None = None,
+    max_memory: float | None = None,
 ) -> TimeHistory:
     """Time history of a linear structure carrying masses that may stick or slide.
 
     Parameters
     ----------
-    M, C, K : (n, n) structural mass [kg], damping [N·s/m], stiffness [N/m]. ``M`` excludes the
-        sliders' horizontal masses (they are the sliders).
+    M, C, K : (n, n) structural mass [kg], damping [N·s/m], stiffness [N/m], dense arrays or
+        scipy sparse matrices. ``M`` excludes the sliders' horizontal masses (they are the
+        sliders).
     sliders : masses resting on DOFs with static / dynamic friction.
     dt : time step [s]; excitation arrays are sampled at ``t_k = k dt`` and interpolated linearly.
     n_steps : number of steps; inferred from the excitation when omitted.
@@ -116,21 +115,29 @@ def simulate(
     backend : "auto" (numba if installed), "numba" or "python" (the pure-Python twin).
     throw : raise :class:`SolverError` on failure; otherwise return with ``status`` set.
     progress : called with the number of steps just completed, after each chunk of
-        ``chunk_steps`` steps (default 2000 when ``progress`` is given); chunking does not change
-        the result, the contact state carries over exactly.
+        ``chunk_steps`` steps (default 2000 when ``progress`` is given, else 20000); chunking
+        does not change the result, the contact state carries over exactly.
     method : "exact" propagates every contact configuration with its own closed-form modal
         solution (exact between events for loads linear inside a step; needs classical damping
         in every configuration: no damping, C ∝ K, or no slider on the structure), "newmark"
         uses average-acceleration Newmark, "auto" (default) takes "exact" when it applies.
+    basis : "full" (every mode: no truncation), "reduced" (Ritz basis of
+        :func:`~seisrack.dynamics.basis.reduced_basis` with its default cut-off), "auto"
+        (full up to ``AUTO_FULL_MAX_DOF`` DOFs, reduced above), or a
+        :class:`~seisrack.dynamics.basis.Basis`.
+    save_every : keep every k-th sample of the histories (the last sample is always kept);
+        ``None`` keeps only the first and last samples (peaks then come from ``on_chunk``).
+    on_chunk : called with the full-rate :class:`Chunk` of each chunk of steps (for peaks or
+        streaming without keeping the histories).
+    max_memory : bytes the kept histories and buffers may use (default: 80 % of the memory
+        available now); a larger run is refused before anything is allocated.
     """
-    M = _square("M", M, None)
+    M = chk.square("M", M, None)
     n = M.shape[0]
-    C = _square("C", C, n)
-    K = _square("K", K, n)
-    if not np.allclose(M, M.T, rtol=1e-10, atol=1e-12 * np.max(np.abs(M))):
-        raise InputError("M", "non-symmetric matrix", "a symmetric matrix")
-    if not np.allclose(K, K.T, rtol=1e-10, atol=1e-12 * max(np.max(np.abs(K)), 1e-300)):
-        raise InputError("K", "non-symmetric matrix", "a symmetric matrix")
+    C = chk.square("C", C, n)
+    K = chk.square("K", K, n)
+    chk.check_symmetric("M", M)
+    chk.check_symmetric("K", K)
     if not isinstance(sliders, Sliders):
         raise InputError("sliders", type(sliders).__name__, "a seisrack.dynamics.Sliders")
     if not (isinstance(dt, int | float) and np.isfinite(dt) and dt > 0):
@@ -155,106 +162,109 @@ def simulate(
         raise InputError("n_steps", n_steps, "an integer >= 1")
     n_steps = int(n_steps)
     n_t = n_steps + 1
-    ag = np.zeros(n_t) if ground_accel is None else _series("ground_accel", ground_accel, (n_t,))
-    r = np.ones(n) if influence is None else _series("influence", influence, (n,))
-    F = None if force is None else _series("force", force, (n_t, n))
-    av = None if vertical_accel is None else _series("vertical_accel", vertical_accel, (n_t,))
-    q_u0 = np.zeros(n) if u0 is None else _series("u0", u0, (n,))
-    q_v0 = np.zeros(n) if v0 is None else _series("v0", v0, (n,))
-
-    w2, phi = modal_basis(M, K)
-    cq = phi.T @ C @ phi
-    off = cq - np.diag(np.diag(cq))
-    diag = bool(np.max(np.abs(off)) <= 1e-10 * max(np.max(np.abs(np.diag(cq))), 1e-300))
-    cd = np.diag(cq).copy() if diag else np.zeros(n)  # writable: one numba specialisation
-    Cq = np.zeros((1, 1)) if diag else np.ascontiguousarray(cq)
-    gamma = phi.T @ (M @ r)
-    pext = -np.outer(ag, gamma)
-    if F is not None:
-        pext += F @ phi
+    ag = np.zeros(n_t) if ground_accel is None else chk.series("ground_accel", ground_accel, (n_t,))
+    r = np.ones(n) if influence is None else chk.series("influence", influence, (n,))
+    F = None if force is None else chk.series("force", force, (n_t, n))
+    av = None if vertical_accel is None else chk.series("vertical_accel", vertical_accel, (n_t,))
+    rv = None
     if av is not None and vertical_influence is not None:
-        rv = _series("vertical_influence", vertical_influence, (n,))
-        pext -= np.outer(av, phi.T @ (M @ rv))
-    m = sliders.count
-    gz = g + (av if av is not None else np.zeros(n_t))
-    N = np.clip(np.outer(gz, sliders.mass), 0.0, None)
-    # P maps modal coordinates to each slider's support motion (a zero row: rests on the ground)
-    on_structure = sliders.dof >= 0
-    P = np.zeros((m, n))
-    P[on_structure] = phi[sliders.dof[on_structure], :]
-    # Φ is M-orthonormal: q = Φᵀ M u
-    q0 = phi.T @ (M @ q_u0)
-    qd0 = phi.T @ (M @ q_v0)
-
-    if chunk_steps is not None and (int(chunk_steps) != chunk_steps or chunk_steps < 1):
-        raise InputError("chunk_steps", chunk_steps, "an integer >= 1")
+        rv = chk.series("vertical_influence", vertical_influence, (n,))
+    q_u0 = np.zeros(n) if u0 is None else chk.series("u0", u0, (n,))
+    q_v0 = np.zeros(n) if v0 is None else chk.series("v0", v0, (n,))
+    if chunk_steps is not None:
+        chk.positive_int("chunk_steps", chunk_steps)
+    if save_every is not None:
+        save_every = chk.positive_int("save_every", save_every)
     if method not in ("auto", "exact", "newmark"):
         raise InputError("method", method, '"auto", "exact" or "newmark"')
+    m = sliders.count
+    chunk = int(chunk_steps or (2000 if progress is not None else DEFAULT_CHUNK))
+    chunk = min(chunk, n_steps)
+
+    bas = _choose_basis(basis, M, K, sliders, r, rv, F)
+    phi, w2 = bas.phi, bas.w2
+    nb = w2.shape[0]
+    n_keep = _kept_samples(n_steps, save_every)
+    _check_memory(n_keep, chunk, nb, m, n_t, max_memory)
+
+    cq = phi.T @ (C @ phi)
+    off = cq - np.diag(np.diag(cq))
+    diag = bool(np.max(np.abs(off)) <= 1e-10 * max(np.max(np.abs(np.diag(cq))), 1e-300))
+    cd = np.diag(cq).copy() if diag else np.zeros(nb)
+    Cq = np.zeros((1, 1)) if diag else np.ascontiguousarray(cq)
+    # load split p(t) = series(t) @ pat in basis coordinates (few patterns when possible)
+    pat, series = _load_patterns(phi, M, r, ag, F, av, rv)
+    gz = g + (av if av is not None else np.zeros(n_t))
+    on_structure = sliders.dof >= 0
+    P = np.zeros((m, nb))  # maps basis coordinates to each slider's support (zero: on the ground)
+    P[on_structure] = phi[sliders.dof[on_structure], :]
+    q0 = phi.T @ (M @ q_u0)  # Φ is M-orthonormal: q = Φᵀ M u
+    qd0 = phi.T @ (M @ q_v0)
+
     why_not = _exact_unsupported(w2, cd, diag, sliders.dof)
     if method == "exact" and why_not:
         raise InputError("method", method, f'"newmark" or "auto" here: {why_not}')
     use_exact = method != "newmark" and not why_not
     kern = get_kernel(backend, "exact" if use_exact else "newmark")
     used = "numba" if kern.__name__.endswith("_numba") else "python"
-    out_q = np.empty((n_t, n))
-    out_qd = np.empty((n_t, n))
-    out_qdd = np.empty((n_t, n))
-    out_w = np.empty((n_t, m))
-    out_wd = np.empty((n_t, m))
-    out_lam = np.empty((n_t, m))
-    out_stuck = np.empty((n_t, m), dtype=np.bool_)
-    out_energy = np.zeros((n_t, 5))
+    mass = chk.writable(sliders.mass)
+    mus = chk.writable(sliders.mu_static)
+    mud = chk.writable(sliders.mu_dynamic)
+    P = chk.writable(P)
+    w2c = chk.writable(w2)
+    ag = chk.writable(ag)
+    pat = chk.writable(pat)
+
+    buf = _Buffers(chunk + 1, nb, m)
+    keep = _Kept(n_keep, nb, m, track_energy)
     ev_time = np.empty(max_events + 1)
     ev_slider = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
-    w2c = np.ascontiguousarray(w2)
-    ag = np.ascontiguousarray(ag)
-    pext = np.ascontiguousarray(pext)
-    N = np.ascontiguousarray(N)
     w_state = np.zeros(m)
     wd_state = np.zeros(m)
     stuck_state = np.ones(m, dtype=np.bool_)
     sig_state = np.ones(m)
     e_state = np.zeros(3)
-    chunk = n_steps if chunk_steps is None and progress is None else int(chunk_steps or 2000)
     status, n_ev, n_sub, n_cfg = 0, 0, 0, 0
     if use_exact:
         a1 = _stiffness_proportional(w2, cd)
-        rv_in = None if vertical_influence is None else np.asarray(vertical_influence, float)
-        pat, series = _load_patterns(n, ag, gamma, F, phi, av, rv_in, M, pext)
-        cache_size = int(np.clip(2.0e8 / (8.0 * (3 * n * n + n * m + 16 * n + 1)), 4, 64))
+        cache_size = int(np.clip(2.0e8 / (8.0 * (2 * nb * nb + nb * pat.shape[0] + 6 * nb + m)),
+                                 4, 64))
+    qs, qds = q0, qd0
     start = 0
     while start < n_steps:
         stop = min(start + chunk, n_steps)
         rows = slice(start, stop + 1)
-        qs = q0 if start == 0 else out_q[start].copy()
-        qds = qd0 if start == 0 else out_qd[start].copy()
+        k = stop - start + 1
+        ser = np.ascontiguousarray(series[rows])
+        pext = np.ascontiguousarray(ser @ pat)
+        N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
+        ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
+        left = max(int(max_events) - n_ev, 0)
+        outs = buf.views(k)
         if use_exact:
             st, ne, ns, nc = kern.run_kernel_exact(
-                w2c, cd, a1, not bool(np.any(sliders.dof >= 0)), P, sliders.mass,
-                sliders.mu_static, sliders.mu_dynamic, float(dt), ag[rows], pext[rows], pat,
-                series[rows], N[rows], qs, qds,
+                w2c, cd, a1, not bool(np.any(on_structure)), P, mass, mus, mud, float(dt),
+                ag[rows], pext, pat, ser, N, qs, qds,
                 start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
-                start * float(dt), bool(track_energy), max(int(max_events) - n_ev, 0),
-                _MAX_SUBSTEPS, cache_size,
-                out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows], out_wd[rows],
-                out_lam[rows], out_stuck[rows], out_energy[rows],
-                ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
+                start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
+                *outs, *ev,
             )
             n_cfg += int(nc)
         else:
             st, ne, ns = kern.run_kernel(
-                w2c, cd, Cq, diag, P, sliders.mass, sliders.mu_static, sliders.mu_dynamic,
-                float(dt), ag[rows], pext[rows], N[rows], qs, qds,
+                w2c, cd, Cq, diag, P, mass, mus, mud, float(dt), ag[rows], pext, N, qs, qds,
                 start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
-                start * float(dt), bool(track_energy), max(int(max_events) - n_ev, 0),
-                _MAX_SUBSTEPS, out_q[rows], out_qd[rows], out_qdd[rows], out_w[rows],
-                out_wd[rows], out_lam[rows], out_stuck[rows], out_energy[rows],
-                ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:],
+                start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
             )
         n_ev += int(ne)
         n_sub += int(ns)
         status = int(st)
+        t_chunk = np.arange(start, stop + 1) * dt
+        if on_chunk is not None:
+            on_chunk(Chunk(t_chunk, *outs[:7]))
+        keep.take(start, stop, n_steps, save_every, outs, N)
+        qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
         if status != 0:
             break
         if progress is not None:
@@ -266,32 +276,28 @@ def simulate(
         if throw:
             raise SolverError(msg)
         _LOG.warning(msg)
-    n_keep = min(int(n_ev), max_events)
+    n_keep_ev = min(int(n_ev), max_events)
     events = [
         Event(float(ev_time[k]), int(ev_slider[k]), EVENT_KINDS[int(ev_kind[k])])
-        for k in range(n_keep)
+        for k in range(n_keep_ev)
     ]
+    kq, kqd, kqdd, kw, kwd, klam, kst, ken, kN, kidx = keep.result()
     energy = {}
     if track_energy:
-        energy = {
-            "input": out_energy[:, 0].copy(),
-            "kinetic": out_energy[:, 1].copy(),
-            "strain": out_energy[:, 2].copy(),
-            "damping": out_energy[:, 3].copy(),
-            "friction": out_energy[:, 4].copy(),
-        }
+        names = ("input", "kinetic", "strain", "damping", "friction")
+        energy = {nm: ken[:, c].copy() for c, nm in enumerate(names)}
     return TimeHistory(
-        t=np.arange(n_t) * dt,
-        q=out_q,
-        qd=out_qd,
-        qdd=out_qdd,
+        t=kidx * dt,
+        q=kq,
+        qd=kqd,
+        qdd=kqdd,
         phi=phi,
-        slider_u=out_w,
-        slider_v=out_wd,
-        sliding=out_w - out_q @ P.T,
-        friction=out_lam,
-        normal=N,
-        stuck=out_stuck,
+        slider_u=kw,
+        slider_v=kwd,
+        sliding=kw - kq @ P.T,
+        friction=klam,
+        normal=kN,
+        stuck=kst,
         slider_dof=sliders.dof.copy(),
         events=events,
         energy=energy,
@@ -300,7 +306,61 @@ def simulate(
         n_substeps=int(n_sub),
         method="exact" if use_exact else "newmark",
         n_configurations=int(n_cfg),
+        basis=bas.describe(),
+        sample_index=kidx,
     )
+
+
+def _choose_basis(basis, M, K, sliders, r, rv, F) -> Basis:  # noqa: ANN001, N803
+    n = M.shape[0]
+    if isinstance(basis, Basis):
+        if basis.phi.shape[0] != n:
+            raise InputError("basis", f"phi of shape {basis.phi.shape}", f"phi with {n} rows")
+        return basis
+    if basis not in ("auto", "full", "reduced"):
+        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
+        return full_basis(M, K)
+    on = sliders.dof >= 0
+    extra = np.zeros(n)
+    np.add.at(extra, sliders.dof[on], sliders.mass[on])
+    loads = [M @ r + extra * r]
+    if rv is not None:
+        loads.append(M @ rv)
+    if F is not None:
+        loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
+        if loaded.size <= 10:
+            for d in loaded:
+                e = np.zeros(n)
+                e[d] = 1.0
+                loads.append(e)
+    return reduced_basis(M, K, sliders.dof, sliders.mass, np.column_stack(loads))
+
+
+def _kept_samples(n_steps: int, save_every: int | None) -> int:
+    if save_every is None:
+        return 2
+    return n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
+
+
+def _check_memory(n_keep: int, chunk: int, nb: int, m: int, n_t: int,
+                  max_memory: float | None) -> None:
+    """Refuse a run whose histories and buffers would not fit, before allocating them."""
+    per_row = 8 * (3 * nb + 4 * m + 5) + m
+    need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
+    if max_memory is None:
+        try:
+            avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+            return
+        max_memory = 0.8 * avail
+    if need > max_memory:
+        raise InputError(
+            "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "
+            f"{m} sliders ({need / 2**30:.2f} GiB)",
+            f"a run that fits in {max_memory / 2**30:.2f} GiB",
+            hint="Keep fewer samples (save_every=k, or None with on_chunk for peaks only)",
+        )
 
 
 def _stiffness_proportional(w2: np.ndarray, cd: np.ndarray) -> float:
@@ -326,15 +386,13 @@ def _exact_unsupported(w2: np.ndarray, cd: np.ndarray, diag: bool, dof: np.ndarr
     return ""
 
 
-def _load_patterns(n, ag, gamma, F, phi, av, rv, M, pext):  # noqa: ANN001, ANN202, N803
-    """Split the modal load as ``pext = series @ pat`` with few patterns when possible."""
-    pats = [-gamma]
+def _load_patterns(phi, M, r, ag, F, av, rv):  # noqa: ANN001, ANN202, N803
+    """Split the basis-coordinate load as ``p(t) = series(t) @ pat`` (one pattern per loaded
+    DOF of ``F``, so the per-chunk product costs O(n_t · patterns · r))."""
+    pats = [-(phi.T @ (M @ r))]
     cols = [ag]
     if F is not None:
-        loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
-        if loaded.size > max(n // 2, 1):
-            return np.eye(n), np.ascontiguousarray(pext)
-        for d in loaded:
+        for d in np.flatnonzero(np.any(F != 0.0, axis=0)):
             pats.append(phi[d, :])
             cols.append(F[:, d])
     if av is not None and rv is not None:

@@ -31,6 +31,9 @@ class TimeHistory:
     friction: (n_t, m) [N] horizontal force of the structure on each slider;
     normal: (n_t, m) [N] normal force; stuck: (n_t, m) bool;
     energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction.
+    Here ``n_t`` counts the *kept* samples: with ``simulate(save_every=k)`` they are the steps
+    listed in ``sample_index`` (every k-th and the last), at times ``t``. ``basis`` describes
+    the basis ``phi`` (full, or reduced with its cut-off), see :mod:`seisrack.dynamics.basis`.
     """
 
     t: np.ndarray
@@ -52,6 +55,8 @@ class TimeHistory:
     n_substeps: int = 0
     method: str = "newmark"
     n_configurations: int = 0
+    basis: dict = field(default_factory=dict)
+    sample_index: np.ndarray | None = None
 
     @cached_property
     def u(self) -> np.ndarray:

@@ -1,0 +1,178 @@
+"""Bases of the structure in which the stick–slip engine integrates (theory: §10 of
+``docs/theory/stick_slip_engine.md``).
+
+The engine works in coordinates ``u = Φ q`` with ``Φᵀ M Φ = I`` and ``Φᵀ K Φ = diag(ω²)``,
+where ``M`` is the structure's own mass (the sliders' horizontal masses are the sliders).
+
+- :func:`full_basis`: every mode of ``(K, M)`` (dense ``eigh``); nothing is truncated.
+- :func:`reduced_basis`: a load-dependent Ritz basis of ``r ≪ n`` vectors (Wilson, Yuan &
+  Dickens, *Earthquake Eng. Struct. Dyn.* 10, 1982; Craig & Kurdila, *Fundamentals of
+  Structural Dynamics*, 2nd ed., §14.6): Krylov blocks ``(K⁻¹ M₀)ᵏ K⁻¹ F`` of the loads that
+  actually act — the ground load and the sliders' friction forces — with the sliders rigidly
+  attached in ``M₀ = M + Σ m_j e_j e_jᵀ``. The first block is the static response, so the
+  quasi-static part of every truncated mode is kept; only inertia of modes outside the Krylov
+  space is lost. The truncation is a reported, measured choice (``benchmarks/scale.py``).
+
+Both accept dense arrays or scipy sparse matrices; the reduced basis never forms a dense
+``n x n`` matrix (shift-invert Lanczos on a sparse LU of K).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from seisrack.errors import InputError, SolverError
+
+_LOG = logging.getLogger(__name__)
+
+#: Krylov blocks of the load-dependent Ritz basis
+DEFAULT_BLOCKS = 3
+#: relative M₀-norm below which a Ritz direction is dropped
+DEFAULT_TOL = 1e-2
+#: relative norm below which a Krylov direction counts as linearly dependent
+_DEPENDENT = 1e-7
+#: largest reduced basis
+DEFAULT_MAX_SIZE = 200
+
+
+@dataclass(frozen=True)
+class Basis:
+    """Mass-orthonormal basis of the structure: ``phi.T @ M @ phi = I``, ``phi.T @ K @ phi =
+    diag(w2)``.
+
+    phi: (n, r); w2: (r,) [rad²/s²] ascending. kind: "full" or "reduced".
+    n_modes: basis size (modes of the structure, or Ritz vectors); n_static: Krylov blocks of a
+    reduced basis; highest_mode_hz: highest frequency of the basis [Hz].
+    """
+
+    phi: np.ndarray
+    w2: np.ndarray
+    kind: str
+    n_modes: int
+    n_static: int = 0
+    highest_mode_hz: float | None = None
+
+    @property
+    def size(self) -> int:
+        return int(self.w2.shape[0])
+
+    def describe(self) -> dict:
+        return {
+            "kind": self.kind,
+            "size": self.size,
+            "modes": self.n_modes,
+            "ritz_blocks": self.n_static,
+            "highest_mode_hz": self.highest_mode_hz,
+        }
+
+
+def full_basis(M, K) -> Basis:  # noqa: ANN001, N803
+    """Every mode of ``(K, M)`` by a dense generalised ``eigh`` (no truncation)."""
+    Md = M.toarray() if sp.issparse(M) else np.asarray(M, dtype=float)
+    Kd = K.toarray() if sp.issparse(K) else np.asarray(K, dtype=float)
+    try:
+        w2, phi = scipy.linalg.eigh(Kd, Md)
+    except np.linalg.LinAlgError as exc:
+        raise InputError(
+            "M", "not positive definite", "a symmetric positive-definite mass matrix",
+            hint="Every DOF needs mass (use a consistent mass matrix for rotations)",
+        ) from exc
+    scale = max(float(np.max(np.abs(w2))), 1e-300)
+    if np.min(w2) < -1e-9 * scale:
+        raise InputError(
+            "K", f"negative eigenvalue {np.min(w2):.3g}", "a positive semi-definite stiffness"
+        )
+    return Basis(phi=phi, w2=np.clip(w2, 0.0, None), kind="full", n_modes=int(w2.size))
+
+
+def reduced_basis(
+    M, K, slider_dof: np.ndarray, slider_mass: np.ndarray, loads: np.ndarray,  # noqa: ANN001, N803
+    *, tol: float = DEFAULT_TOL, blocks: int = DEFAULT_BLOCKS, max_size: int = DEFAULT_MAX_SIZE,
+) -> Basis:
+    """Load-dependent Ritz basis (Wilson, Yuan & Dickens 1982; block form).
+
+    The first block is the static response ``K⁻¹ F`` to the load patterns that act on the
+    structure: ``loads`` (e.g. the ground load ``M₀ r``) and a unit horizontal force at every
+    slider's DOF (the friction forces). Each next block is ``K⁻¹ M₀`` times the previous one.
+    Every block is made ``M₀``-orthonormal against the basis so far and compressed: with every
+    pattern scaled to unit ``M₀``-norm, directions below ``tol`` are dropped, so sliders on one
+    beam, whose static responses differ only by the beam's axial strain, share directions.
+    ``blocks`` blocks are built (at most ``max_size`` vectors). A final Rayleigh–Ritz step on
+    ``(K, M)`` makes the basis M-orthonormal and K-diagonal.
+
+    M, K: (n, n) dense or sparse; slider_dof, slider_mass: (m,) (dof -1: on the ground);
+    loads: (n, k) load patterns [N per unit of their time series].
+    """
+    n = K.shape[0]
+    if not (np.isfinite(tol) and 0 < tol < 1):
+        raise InputError("basis.tol", tol, "a relative tolerance in (0, 1), e.g. 1e-4")
+    if isinstance(blocks, bool) or not isinstance(blocks, int) or blocks < 1:
+        raise InputError("basis.blocks", blocks, "an integer >= 1")
+    Ks = sp.csc_matrix(K)
+    Ms = sp.csc_matrix(M)
+    dof = np.asarray(slider_dof)
+    on = dof >= 0
+    add = sp.csc_matrix((np.asarray(slider_mass, float)[on], (dof[on], dof[on])), shape=(n, n))
+    M0 = (Ms + add).tocsc()
+    try:
+        lu = spla.splu(Ks)
+    except RuntimeError as exc:
+        raise InputError(
+            "K", "singular", "a stable structure (positive-definite stiffness)"
+        ) from exc
+    loads = np.asarray(loads, dtype=float).reshape(n, -1)
+    udofs = np.unique(dof[on])
+    F = np.zeros((n, loads.shape[1] + udofs.size))
+    F[:, : loads.shape[1]] = loads
+    F[udofs, loads.shape[1] + np.arange(udofs.size)] = 1.0
+    block = lu.solve(np.asfortranarray(F))
+    V = np.zeros((n, 0))
+    n_blocks = 0
+    while n_blocks < blocks and V.shape[1] < max_size:
+        # the first block is compressed at ``tol``; later ones drop only dependent directions
+        cut = tol if n_blocks == 0 else _DEPENDENT
+        block = _orthonormal_block(block, V, M0, cut, max_size - V.shape[1])
+        if block.shape[1] == 0:
+            break
+        V = np.column_stack([V, block])
+        n_blocks += 1
+        block = lu.solve(np.asfortranarray(M0 @ block))
+    Kr = V.T @ (Ks @ V)
+    Mr = V.T @ (Ms @ V)
+    try:
+        w2, W = scipy.linalg.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
+    except np.linalg.LinAlgError as exc:
+        raise SolverError(f"reduced basis: Rayleigh-Ritz failed ({exc})") from exc
+    w2 = np.clip(w2, 0.0, None)
+    return Basis(
+        phi=np.ascontiguousarray(V @ W), w2=w2, kind="reduced", n_modes=int(w2.size),
+        n_static=n_blocks,
+        highest_mode_hz=float(np.sqrt(w2[-1]) / (2 * np.pi)) if w2.size else None,
+    )
+
+
+def _orthonormal_block(X, V, M0, tol, limit):  # noqa: ANN001, ANN202, N803
+    """M₀-orthonormalise the columns of X against V and among themselves, dropping the
+    directions below ``tol`` (relative); at most ``limit`` columns."""
+    # each load pattern counts alike whatever its units: scale the columns to unit M₀-norm
+    norms = np.sqrt(np.einsum("ij,ij->j", X, M0 @ X))
+    X = X[:, norms > 0] / norms[norms > 0]
+    ref = 1.0
+    for _ in range(2):  # twice is enough (Kahan–Parlett)
+        if V.shape[1]:
+            X = X - V @ (V.T @ (M0 @ X))
+    G = X.T @ (M0 @ X)
+    lam, Q = np.linalg.eigh(0.5 * (G + G.T))
+    keep = lam > (tol * ref) ** 2
+    lam, Q = lam[keep][::-1][:limit], Q[:, keep][:, ::-1][:, :limit]
+    Y = (X @ Q) / np.sqrt(lam)
+    if V.shape[1] and Y.shape[1]:  # one more pass against V for round-off
+        Y = Y - V @ (V.T @ (M0 @ Y))
+        Y = Y / np.sqrt(np.einsum("ij,ij->j", Y, M0 @ Y))
+    return Y
