@@ -32,11 +32,14 @@ from seisrack.errors import InputError, SolverError
 _LOG = logging.getLogger(__name__)
 
 #: Krylov blocks of the load-dependent Ritz basis
-DEFAULT_BLOCKS = 3
+DEFAULT_BLOCKS = 8
 #: relative M₀-norm below which a Ritz direction is dropped
-DEFAULT_TOL = 1e-2
+DEFAULT_TOL = 3e-2
 #: relative norm below which a Krylov direction counts as linearly dependent
 _DEPENDENT = 1e-7
+#: Krylov blocks after the first are added only while the basis stays within this size (small
+#: structures get more blocks for free; large ones keep the cost per contact event low)
+DEFAULT_TARGET_SIZE = 40
 #: largest reduced basis
 DEFAULT_MAX_SIZE = 200
 
@@ -93,7 +96,8 @@ def full_basis(M, K) -> Basis:  # noqa: ANN001, N803
 
 def reduced_basis(
     M, K, slider_dof: np.ndarray, slider_mass: np.ndarray, loads: np.ndarray,  # noqa: ANN001, N803
-    *, tol: float = DEFAULT_TOL, blocks: int = DEFAULT_BLOCKS, max_size: int = DEFAULT_MAX_SIZE,
+    *, tol: float = DEFAULT_TOL, blocks: int = DEFAULT_BLOCKS,
+    target_size: int = DEFAULT_TARGET_SIZE, max_size: int = DEFAULT_MAX_SIZE,
 ) -> Basis:
     """Load-dependent Ritz basis (Wilson, Yuan & Dickens 1982; block form).
 
@@ -103,7 +107,8 @@ def reduced_basis(
     Every block is made ``M₀``-orthonormal against the basis so far and compressed: with every
     pattern scaled to unit ``M₀``-norm, directions below ``tol`` are dropped, so sliders on one
     beam, whose static responses differ only by the beam's axial strain, share directions.
-    ``blocks`` blocks are built (at most ``max_size`` vectors). A final Rayleigh–Ritz step on
+    The first block is always kept (at most ``max_size`` vectors); up to ``blocks - 1`` more
+    are added while the basis stays within ``target_size`` vectors. A final Rayleigh–Ritz step on
     ``(K, M)`` makes the basis M-orthonormal and K-diagonal.
 
     M, K: (n, n) dense or sparse; slider_dof, slider_mass: (m,) (dof -1: on the ground);
@@ -139,6 +144,8 @@ def reduced_basis(
         cut = tol if n_blocks == 0 else _DEPENDENT
         block = _orthonormal_block(block, V, M0, cut, max_size - V.shape[1])
         if block.shape[1] == 0:
+            break
+        if n_blocks and V.shape[1] + block.shape[1] > max(target_size, 1):
             break
         V = np.column_stack([V, block])
         n_blocks += 1

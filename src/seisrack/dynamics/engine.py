@@ -17,6 +17,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._store import Buffers as _Buffers
@@ -232,44 +233,51 @@ def simulate(
                                  4, 64))
     qs, qds = q0, qd0
     start = 0
-    while start < n_steps:
-        stop = min(start + chunk, n_steps)
-        rows = slice(start, stop + 1)
-        k = stop - start + 1
-        ser = np.ascontiguousarray(series[rows])
-        pext = np.ascontiguousarray(ser @ pat)
-        N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
-        ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
-        left = max(int(max_events) - n_ev, 0)
-        outs = buf.views(k)
-        if use_exact:
-            st, ne, ns, nc = kern.run_kernel_exact(
-                w2c, cd, a1, not bool(np.any(on_structure)), P, mass, mus, mud, float(dt),
-                ag[rows], pext, pat, ser, N, qs, qds,
-                start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
-                start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
-                *outs, *ev,
-            )
-            n_cfg += int(nc)
-        else:
-            st, ne, ns = kern.run_kernel(
-                w2c, cd, Cq, diag, P, mass, mus, mud, float(dt), ag[rows], pext, N, qs, qds,
-                start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
-                start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
-            )
-        n_ev += int(ne)
-        n_sub += int(ns)
-        status = int(st)
-        t_chunk = np.arange(start, stop + 1) * dt
-        if on_chunk is not None:
-            on_chunk(Chunk(t_chunk, *outs[:7]))
-        keep.take(start, stop, n_steps, save_every, outs, N)
-        qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
-        if status != 0:
-            break
-        if progress is not None:
-            progress(stop - start)
-        start = stop
+    # The kernel's algebra is small (r x r): a threaded BLAS only adds spinning threads, which
+    # made runs 5-10x slower on a loaded 2-core machine (measured on the warehouse rack).
+    limiter = threadpool_limits(limits=1, user_api="blas")
+    try:
+        while start < n_steps:
+            stop = min(start + chunk, n_steps)
+            rows = slice(start, stop + 1)
+            k = stop - start + 1
+            ser = np.ascontiguousarray(series[rows])
+            pext = np.ascontiguousarray(ser @ pat)
+            N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
+            ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
+            left = max(int(max_events) - n_ev, 0)
+            outs = buf.views(k)
+            if use_exact:
+                st, ne, ns, nc = kern.run_kernel_exact(
+                    w2c, cd, a1, not bool(np.any(on_structure)), P, mass, mus, mud, float(dt),
+                    ag[rows], pext, pat, ser, N, qs, qds,
+                    start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                    start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
+                    *outs, *ev,
+                )
+                n_cfg += int(nc)
+            else:
+                st, ne, ns = kern.run_kernel(
+                    w2c, cd, Cq, diag, P, mass, mus, mud, float(dt), ag[rows], pext, N, qs, qds,
+                    start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                    start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
+                )
+            n_ev += int(ne)
+            n_sub += int(ns)
+            status = int(st)
+            t_chunk = np.arange(start, stop + 1) * dt
+            if on_chunk is not None:
+                on_chunk(Chunk(t_chunk, *outs[:7]))
+            keep.take(start, stop, n_steps, save_every, outs, N)
+            qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
+            if status != 0:
+                break
+            if progress is not None:
+                progress(stop - start)
+            start = stop
+    finally:
+        limiter.restore_original_limits()
+
     status_text = _STATUS.get(int(status), f"status {status}")
     if status != 0:
         msg = f"stick-slip integration stopped: {status_text}"
