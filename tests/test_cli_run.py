@@ -171,6 +171,7 @@ def _bad_cases(tmp: Path, rec_csv: Path) -> list[tuple[str, list[str], str]]:
         ("plot-without-out", [*m, "--plot"], "--plot"),
         ("free-vibration-negative", [*m, "--free-vibration", "-1"], "--free-vibration"),
         ("bad-units", [*m, "--units", "furlong"], "--units"),
+        ("save-every-zero", [*m, "--save-every", "0"], "--save-every"),
     ]
 
 
@@ -186,6 +187,7 @@ def bad_cases(tmp_path_factory, rec_csv):
     "dt-negative", "vertical-dt", "vertical-length", "vertical-missing", "mu-negative",
     "mu-nan", "mud-above-mus", "mud-without-mu", "unknown-builtin", "out-is-file",
     "out-under-file", "plot-without-out", "free-vibration-negative", "bad-units",
+    "save-every-zero",
 ])
 def test_bad_input(capsys, bad_cases, case):
     args, field = bad_cases[case]
@@ -229,3 +231,19 @@ def test_method_option(capsys, rec_csv):
     a = exact["peaks"]["beam_displacement_m"]
     b = newmark["peaks"]["beam_displacement_m"]
     assert a == pytest.approx(b, rel=5e-3) and a != b
+
+
+def test_basis_save_every_and_rigid_check(capsys, rec_csv):
+    """--basis reduced stays within 0.5 % of the full basis on the paper rack; --save-every
+    keeps fewer samples without changing a peak; --rigid-check takes alpha from a rigid run."""
+    full = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3")
+    red = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--basis", "reduced",
+                "--save-every", "10", "--rigid-check")
+    assert full["basis"]["kind"] == "full" and red["basis"]["kind"] == "reduced"
+    assert red["basis"]["size"] < full["basis"]["size"]
+    for key in ("beam_displacement_m", "base_shear_N"):
+        assert red["peaks"][key] == pytest.approx(full["peaks"][key], rel=5e-3)
+    assert red["peaks"]["pallet_sliding_m"] == pytest.approx(full["peaks"]["pallet_sliding_m"],
+                                                             rel=5e-3, abs=1e-6)
+    assert full["simplified_check"]["alpha_source"].startswith("this run")
+    assert red["simplified_check"]["alpha_source"] == "rigid companion run"

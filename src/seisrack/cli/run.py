@@ -58,6 +58,15 @@ def register(subparsers: Any) -> None:
                    help="time integration: exact modal propagators per contact configuration "
                         "(needs no damping or stiffness-proportional damping), Newmark average "
                         "acceleration, or auto (exact when it applies; default)")
+    p.add_argument("--basis", choices=("auto", "full", "reduced"), default="auto",
+                   help="structure basis: every mode (full), a load-dependent Ritz basis "
+                        "(reduced), or auto (full up to 300 DOFs; default)")
+    p.add_argument("--save-every", type=int, default=1, metavar="K",
+                   help="keep every K-th analysis step in the histories (peaks always use "
+                        "every step; default 1)")
+    p.add_argument("--rigid-check", action="store_true",
+                   help="also run the rack with rigidly held pallets, for the simplified "
+                        "mu >= alpha check (a second run)")
     p.add_argument("--free-vibration", type=float, default=0.0, metavar="S",
                    help="[s] of free vibration after the record (default 0)")
     p.add_argument("--out", metavar="DIR", help=_OUT_HELP)
@@ -94,6 +103,8 @@ def _check_options(args: argparse.Namespace) -> None:
                   args.motion_dt is not None and args.motion_dt > 0)
     _check_number("--free-vibration", args.free_vibration, "a duration >= 0 s",
                   args.free_vibration >= 0)
+    if args.save_every < 1:
+        raise InputError("--save-every", args.save_every, "an integer >= 1")
     if args.plot and not args.out:
         raise InputError("--plot", True, "used together with --out DIR (figures go there)")
 
@@ -205,6 +216,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         resp = run_rack(model, rec, dt=rec.dt / k, vertical=vert,
                         free_vibration=args.free_vibration, method=args.method,
+                        basis=args.basis, save_every=args.save_every,
+                        rigid_companion=args.rigid_check,
                         progress=None if bar is None else bar.update)
     finally:
         if bar is not None:
@@ -212,7 +225,7 @@ def run(args: argparse.Namespace) -> int:
 
     summary = resp.summary()
     summary = {"rack": args.rack, "title": spec.title, **summary,
-               "integration": resp.history.method}
+               "integration": resp.history.method, "basis": resp.history.basis}
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot)  # adds summary["outputs"]
     if args.json:
