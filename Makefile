@@ -30,7 +30,12 @@ lint: $(STAMP)
 	$(BIN)/python -m ruff check src tests benchmarks
 
 bench: $(STAMP)
+	# OpenSeesPy needs the system BLAS/LAPACK (Debian packages), installed here when possible
+	if command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && \
+	   ! dpkg -s libblas3 liblapack3 >/dev/null 2>&1; then \
+	   apt-get update -qq && apt-get install -y -qq libblas3 liblapack3; fi
 	$(BIN)/python -m pip install --quiet -e '.[bench]'
+	$(BIN)/python benchmarks/scale.py
 	$(BIN)/python benchmarks/engine.py
 	$(BIN)/python benchmarks/motion.py
 	$(BIN)/python benchmarks/rack_vs_opensees.py
