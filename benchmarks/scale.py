@@ -247,6 +247,7 @@ def spawn(case: str, **kw: Any) -> dict[str, Any]:
     cmd = [sys.executable, str(Path(__file__).resolve()), "--case", case]
     for k, v in kw.items():
         cmd += [f"--{k.replace('_', '-')}", str(v)]
+    load = os.getloadavg()[0]
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
     timer = threading.Timer(CHILD_LIMIT_S, os.kill, (p.pid, signal.SIGKILL))
@@ -263,6 +264,7 @@ def spawn(case: str, **kw: Any) -> dict[str, Any]:
                if p.returncode == -signal.SIGKILL else f"child failed (exit {p.returncode})"}
     out["peak_rss_mib"] = usage.ru_maxrss / 1024.0  # Linux: KiB
     out["child_wall_s"] = wall
+    out["load_1min_at_start"] = load
     print(f"[scale] {case} {kw}: {json.dumps(_short(out))}", file=sys.stderr, flush=True)
     return out
 
@@ -380,8 +382,8 @@ def report(env: dict, load0: tuple, load1: tuple, base: dict, paper: dict, ladde
       "dt 5 ms (4,000 steps); `save_every=1`.")
     a("")
     a("| levels x bays | DOFs | pallets | slid | events | configurations | basis | "
-      "compile_rack | run_rack | µs / step | peak RSS |")
-    a("|---|---|---|---|---|---|---|---|---|---|---|")
+      "compile_rack | run_rack | µs / step | peak RSS | load at start |")
+    a("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for (lv, nb), r in zip(LADDER, ladder, strict=True):
         if "run_s" not in r:
             a(f"| {lv} x {nb} | {r.get('status', 'missing')} |||||||||| ")
@@ -389,7 +391,8 @@ def report(env: dict, load0: tuple, load1: tuple, base: dict, paper: dict, ladde
         a(f"| {lv} x {nb} | {r['n_dof']:,} | {r['pallets']} | {r['slid']} | {r['events']:,} "
           f"| {r['configurations']:,} | {_basis(r['basis'])} | {_ms(r['compile_s'])}"
           f"{_runs(r['compile_runs'])} | {_ms(r['run_s'])}{_runs(r['run_runs'])} | "
-          f"{1e6 * r['run_s'] / r['n_steps']:,.0f} | {r['peak_rss_mib']:.0f} MiB |")
+          f"{1e6 * r['run_s'] / r['n_steps']:,.0f} | {r['peak_rss_mib']:.0f} MiB | "
+          f"{_f(r.get('load_1min_at_start'), '{:.1f}')} |")
     a("")
     a(f"Exponent of run_rack time against pallet count (least squares on log-log, all "
       f"{sum('run_s' in r for r in ladder)} sizes): **{_f(exponent, '{:.2f}')}** "
@@ -418,6 +421,7 @@ def report(env: dict, load0: tuple, load1: tuple, base: dict, paper: dict, ladde
       f"(largest {_f(r.get('max_sliding_mm'), '{:.1f}')} mm) | |")
     a(f"| events / configurations | {r.get('events', '–')} / {r.get('configurations', '–')} | |")
     a(f"| status | {r.get('status', '–')} | |")
+    a(f"| 1-min load average at start | {_f(r.get('load_1min_at_start'), '{:.1f}')} | |")
     a("")
     a("## 4. OpenSeesPy, same run, same rack, record and step (El Centro x 2, 20 s, dt 5 ms)")
     a("")
