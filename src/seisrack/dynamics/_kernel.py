@@ -18,28 +18,38 @@ Formulation (see ``docs/theory/stick_slip_engine.md``):
   stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by Illinois regula falsi
   (bisection safeguard) on the sub-step length, the step is split there, and the new contact
   state is decided at the acceleration level (active set on ``B = diag(1/m) + P P^T``).
+  Detection, location, transitions and output are the event core in ``_events.py``, shared
+  with the exact kernel; this file holds the Newmark trial step and its driver.
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
 
 import numpy as np
 
-try:  # injected by the loader; identity when this file is imported directly
-    _JIT  # type: ignore[used-before-def]  # noqa: B018
-except NameError:  # pragma: no cover
-
-    def _JIT(f):  # type: ignore[no-redef]
-        return f
-
-
-KIND_SLIP = 0
-KIND_STICK = 1
-KIND_REVERSE = 2
-
-STATUS_OK = 0
-STATUS_EVENT_OVERFLOW = 1
-STATUS_SUBSTEP_LIMIT = 2
-STATUS_NONFINITE = 3
+try:  # names injected by the loader when executed after ``_events.py``
+    _record_events  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._events import (
+        _JIT,
+        STATUS_OK,
+        STATUS_SUBSTEP_LIMIT,
+        _accept_trial,
+        _apply_candidates,
+        _bracket_end,
+        _bracket_start,
+        _classify,
+        _detect,
+        _event_buffers,
+        _finish,
+        _init_sliders,
+        _interp,
+        _propose,
+        _record_events,
+        _release_worst,
+        _sample,
+        _substep_end,
+        _write_output,
+    )
 
 
 @_JIT
@@ -103,11 +113,6 @@ def _mm_pt(A, P):
 
 
 @_JIT
-def _interp(x0, x1, theta):
-    return x0 + theta * (x1 - x0)
-
-
-@_JIT
 def _modal_solve(kd, cd, Cq, diag, h, rhs, out):
     """Solve (K + 2/h C + 4/h^2 I) x = rhs for x (mass is identity in modal coordinates)."""
     n = kd.shape[0]
@@ -161,6 +166,18 @@ def _mv(A, x, out):
 
 
 @_JIT
+def _stuck_index(stuck, n_stuck):
+    """Indices of the ``n_stuck`` stuck sliders."""
+    idx = np.empty(n_stuck, dtype=np.int64)
+    k = 0
+    for j in range(stuck.shape[0]):
+        if stuck[j]:
+            idx[k] = j
+            k += 1
+    return idx
+
+
+@_JIT
 def _trial(
     h, kd, cd, Cq, diag, P, HPt, G, mass, mud, q0, qd0, qdd0, w0, wd0, wdd0,
     ag1, pext1, N1, stuck, sig, Ainv_cache, cache_ok,
@@ -199,12 +216,7 @@ def _trial(
             lam1[j] = -mud[j] * N1[j] * sig[j]
     recomputed = False
     if n_stuck > 0:
-        idx = np.empty(n_stuck, dtype=np.int64)
-        k = 0
-        for j in range(m):
-            if stuck[j]:
-                idx[k] = j
-                k += 1
+        idx = _stuck_index(stuck, n_stuck)
         rhs_s = np.empty(n_stuck)
         for a in range(n_stuck):
             ja = idx[a]
@@ -247,16 +259,6 @@ def _trial(
 
 
 @_JIT
-def _event_values(stuck, sig, lam, N, s, mus, e):
-    """Event functions, positive when the current contact state is violated."""
-    for j in range(stuck.shape[0]):
-        if stuck[j]:
-            e[j] = abs(lam[j]) - mus[j] * N[j]
-        else:
-            e[j] = -sig[j] * s[j]
-
-
-@_JIT
 def _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag, pext, lam, qdd, wdd):
     """Accelerations from equilibrium for given slider forces ``lam``."""
     n = kd.shape[0]
@@ -293,11 +295,7 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
     sdot0 = np.empty(m)
     for j in range(m):
         sdot0[j] = -ag - pb[j]
-    for j in range(m):
-        if cand[j]:
-            stuck[j] = True
-        elif forced[j]:
-            stuck[j] = False
+    _apply_candidates(cand, forced, stuck)
     for _it in range(2 * m + 2):
         n_stuck = 0
         for j in range(m):
@@ -306,12 +304,7 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
             else:
                 lam[j] = -mud[j] * N[j] * sig[j]
         if n_stuck > 0:
-            idx = np.empty(n_stuck, dtype=np.int64)
-            k = 0
-            for j in range(m):
-                if stuck[j]:
-                    idx[k] = j
-                    k += 1
+            idx = _stuck_index(stuck, n_stuck)
             Bss = np.empty((n_stuck, n_stuck))
             r = np.empty(n_stuck)
             for a in range(n_stuck):
@@ -326,22 +319,8 @@ def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuc
             for a in range(n_stuck):
                 lam[idx[a]] = x[a]
         # release the most overloaded stuck slider, one at a time
-        worst = -1
-        worst_ratio = 1.0 + 1e-12
-        for j in range(m):
-            if stuck[j] and not forced[j]:
-                cap = mus[j] * N[j]
-                if cap <= 0.0:
-                    ratio = np.inf if lam[j] != 0.0 else 0.0
-                else:
-                    ratio = abs(lam[j]) / cap
-                if ratio > worst_ratio:
-                    worst_ratio = ratio
-                    worst = j
-        if worst < 0:
+        if _release_worst(stuck, forced, lam, mus, N, sig) < 0:
             break
-        stuck[worst] = False
-        sig[worst] = -1.0 if lam[worst] > 0.0 else 1.0
     ptl = np.empty(n)
     _mv(np.ascontiguousarray(P.T), lam, ptl)
     for i in range(n):
@@ -380,111 +359,43 @@ def run_kernel(
     for j in range(m):
         B[j, j] += 1.0 / mass[j]
     # state
-    q = q_init.copy()
-    qd = qd_init.copy()
-    qdd = np.zeros(n)
-    wdd = np.zeros(m)
-    lam = np.zeros(m)
-    forced = np.zeros(m, dtype=np.bool_)
-    if resume:
-        w = w_state.copy()
-        wd = wd_state.copy()
-        stuck = stuck_state.copy()
-        sig = sig_state.copy()
-        E_in = e_state[0]
-        E_damp = e_state[1]
-        E_fric = e_state[2]
-    else:
-        w = np.empty(m)
-        wd = np.empty(m)
-        _mv(P, q, w)
-        _mv(P, qd, wd)
-        stuck = np.ones(m, dtype=np.bool_)
-        sig = np.ones(m)
-        E_in = 0.0
-        E_damp = 0.0
-        E_fric = 0.0
-    cand = stuck.copy()
+    # state at the start of the (sub)step: T0 rows q, qd, qdd; S0 rows w, wd, lam, s, wdd
+    T0 = np.zeros((3, n))
+    T0[0] = q_init
+    T0[1] = qd_init
+    q, qd, qdd = T0[0], T0[1], T0[2]
+    S0, stuck, sig, cand, forced, E_in, E_damp, E_fric = _init_sliders(
+        5, resume, P, q, qd, w_state, wd_state, stuck_state, sig_state, e_state)
+    w, wd, lam, s0, wdd = S0[0], S0[1], S0[2], S0[3], S0[4]
     _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag[0], pext[0], N[0],
                 stuck, sig, cand, forced, qdd, wdd, lam)
-    n_ev = 0
+    n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
+                          ev_time, ev_slider, ev_kind)
     status = STATUS_OK
-    for j in range(m):
-        if cand[j] and not stuck[j]:
-            if n_ev < max_events:
-                ev_time[n_ev] = t_offset
-                ev_slider[n_ev] = j
-                ev_kind[n_ev] = KIND_SLIP
-            n_ev += 1
-    # buffers
-    q1 = np.empty(n)
-    qd1 = np.empty(n)
-    qdd1 = np.empty(n)
-    w1 = np.empty(m)
-    wd1 = np.empty(m)
-    wdd1 = np.empty(m)
-    lam1 = np.empty(m)
-    s1 = np.empty(m)
-    qb = np.empty(n)
-    qdb = np.empty(n)
-    qddb = np.empty(n)
-    wb = np.empty(m)
-    wdb = np.empty(m)
-    wddb = np.empty(m)
-    lamb = np.empty(m)
-    sb = np.empty(m)
-    e_lo = np.empty(m)
-    e_hi = np.empty(m)
-    e_try = np.empty(m)
-    tolF = np.empty(m)
+    # trial end state and its copy at the bracket's hi end
+    T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(3, n, 5, m)
+    q1, qd1, qdd1 = T1[0], T1[1], T1[2]
+    w1, wd1, lam1, s1, wdd1 = S1[0], S1[1], S1[2], S1[3], S1[4]
     Ainv = np.zeros((m, m))
     cache_ok = False
-    pe0 = np.empty(n)
-    pe1 = np.empty(n)
-    tmpn = np.empty(n)
-    tmpn2 = np.empty(n)
     n_sub_total = 0
-    wk_t = np.empty(n)
-    wk_r = np.empty(n)
-    wk_q = np.empty(n)
-    wk_f = np.empty(n)
-    wk_v = np.empty(m)
-    wk_b = np.empty(m)
-    s0 = np.empty(m)
-    vn0 = np.empty(m)
-    N_lo = np.empty(m)
+    Wn = np.empty((8, n))  # scratch
+    pe0, pe1, tmpn, tmpn2 = Wn[0], Wn[1], Wn[2], Wn[3]
+    wk_t, wk_r, wk_q, wk_f = Wn[4], Wn[5], Wn[6], Wn[7]
+    Wm = np.empty((4, m))
+    wk_v, wk_b, vn0, N_e = Wm[0], Wm[1], Wm[2], Wm[3]
 
-    # save initial point
-    out_q[0, :] = q
-    out_qd[0, :] = qd
-    out_qdd[0, :] = qdd
-    out_w[0, :] = w
-    out_wd[0, :] = wd
-    out_lam[0, :] = lam
-    for j in range(m):
-        out_stuck[0, j] = stuck[j]
-    if track_energy:
-        ke = 0.5 * np.dot(qd, qd)
-        for j in range(m):
-            ke += 0.5 * mass[j] * wd[j] * wd[j]
-        se = 0.0
-        for i in range(n):
-            se += 0.5 * kd[i] * q[i] * q[i]
-        out_energy[0, 0] = E_in
-        out_energy[0, 1] = ke
-        out_energy[0, 2] = se
-        out_energy[0, 3] = E_damp
-        out_energy[0, 4] = E_fric
+    _write_output(0, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy, E_in, E_damp,
+                  E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
     for step in range(n_t - 1):
         tau = 0.0  # fraction of the step already integrated
-        n_sub = 0
+        n_sub = 0  # sub-steps taken in this step
         while True:
-            n_sub += 1
-            if n_sub > max_substeps:
-                status = STATUS_SUBSTEP_LIMIT
-                break
             full = tau == 0.0
             hrem = (1.0 - tau) * dt
+            if n_sub >= max_substeps:
+                status = STATUS_SUBSTEP_LIMIT
+                break
             # end-of-trial excitation (grid value at the end of the step)
             for i in range(n):
                 pe1[i] = pext[step + 1, i]
@@ -506,86 +417,21 @@ def run_kernel(
                     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
                 )
                 cache_ok = False
-            # event detection at the end of the trial (end values only; the start values are
-            # needed only when an event must be located)
-            any_ev = False
-            for j in range(m):
-                n1 = N[step + 1, j]
-                if stuck[j]:
-                    tolF[j] = 1e-11 * mus[j] * max(N[step, j], n1) + 1e-300
-                    e_hi[j] = abs(lam1[j]) - mus[j] * n1
-                else:
-                    # a reversal/stick must be a real sign change of the relative velocity, not
-                    # round-off around zero just after a slip onset with mu_d = mu_s
-                    vscale = abs(wd1[j]) + abs(wd1[j] - s1[j]) + mud[j] * n1 / mass[j] * dt
-                    tolF[j] = 1e-9 * vscale
-                    e_hi[j] = -sig[j] * s1[j]
-                if e_hi[j] > tolF[j]:
-                    any_ev = True
+            any_ev = _detect(stuck, sig, mus, mud, mass, N[step], N[step + 1], lam1, wd1, s1,
+                             dt, tolF, e_hi)
+            theta_hi = 1.0  # fraction of the remaining sub-step
             if any_ev:
                 _mv(P, qd, vn0)
                 for j in range(m):
                     s0[j] = wd[j] - vn0[j]
-                    N_lo[j] = N[step, j] + tau * (N[step + 1, j] - N[step, j])
-                _event_values(stuck, sig, lam, N_lo, s0, mus, e_lo)
-            theta_hi = 1.0  # fractions of the remaining sub-step
-            if any_ev:
-                # Illinois regula falsi on the earliest violated event function (bisection if it
-                # stalls). ``e_lo`` and ``e_hi`` always hold the true event values at the bracket
-                # ends; the Illinois weights only enter the interpolation.
-                theta_lo = 0.0
-                streak = 0
-                side = 0
-                sc_lo = 1.0  # Illinois weights (interpolation only, never the violation test)
-                sc_hi = 1.0
-                # the hi state is the current trial
-                qb[:] = q1
-                qdb[:] = qd1
-                qddb[:] = qdd1
-                wb[:] = w1
-                wdb[:] = wd1
-                wddb[:] = wdd1
-                lamb[:] = lam1
-                sb[:] = s1
+                    N_e[j] = _interp(N[step, j], N[step + 1, j], tau)
+                _bracket_start(br, stuck, sig, lam, N_e, s0, mus, e_lo, T1, S1, Tb, Sb)
                 for _it in range(100):
-                    # earliest crossing by linear interpolation
-                    th = theta_hi
-                    jmin = -1
-                    for j in range(m):
-                        if e_hi[j] > tolF[j]:
-                            # root of e - tolF (the violation threshold), not of e: a slider that
-                            # just slipped starts at e = 0 and creeps up quadratically
-                            elo = min(e_lo[j] - tolF[j], 0.0) * sc_lo
-                            den = (e_hi[j] - tolF[j]) * sc_hi - elo
-                            frac = -elo / den if den > 0.0 else 0.0
-                            tj = theta_lo + frac * (theta_hi - theta_lo)
-                            if tj < th or jmin < 0:
-                                th = tj
-                                jmin = j
-                    if jmin < 0:
+                    th = _propose(br, stuck, e_lo, e_hi, tolF, mus, N[step + 1], hrem, dt)
+                    if th < 0.0:
                         break
-                    # convergence: the violated function is tiny at hi
-                    if stuck[jmin]:
-                        conv = e_hi[jmin] <= 1e-10 * mus[jmin] * N[step + 1, jmin] + tolF[jmin]
-                    else:
-                        conv = e_hi[jmin] <= 2.0 * tolF[jmin]
-                    span = theta_hi - theta_lo
-                    if conv or span * hrem <= 1e-12 * dt:
-                        break
-                    if streak >= 6:  # safeguard: Illinois stalled, bisect
-                        th = theta_lo + 0.5 * span
-                        streak = 0
-                    # keep strictly inside the bracket
-                    if th <= theta_lo + 1e-6 * span:
-                        th = theta_lo + 1e-6 * span
-                    if th >= theta_hi - 1e-6 * span:
-                        th = theta_hi - 1e-6 * span
+                    ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
                     hsub = th * hrem
-                    frac_end = tau + th * (1.0 - tau)
-                    for i in range(n):
-                        tmpn[i] = _interp(pext[step, i], pext[step + 1, i], frac_end)
-                    ag_e = _interp(ag[step], ag[step + 1], frac_end)
-                    N_e = N[step] + frac_end * (N[step + 1] - N[step])
                     HPt = _hmat_pt(kd, cd, Cq, diag, hsub, P)
                     G = _mm_pt(P, np.ascontiguousarray(HPt.T))
                     _trial(
@@ -594,58 +440,19 @@ def run_kernel(
                         q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
                     )
                     cache_ok = False
-                    _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
-                    viol_try = False
-                    for j in range(m):
-                        if e_try[j] > tolF[j]:
-                            viol_try = True
-                    if viol_try:
-                        theta_hi = th
-                        e_hi[:] = e_try
-                        qb[:] = q1
-                        qdb[:] = qd1
-                        qddb[:] = qdd1
-                        wb[:] = w1
-                        wdb[:] = wd1
-                        wddb[:] = wdd1
-                        lamb[:] = lam1
-                        sb[:] = s1
-                        streak = streak + 1 if side == 1 else 1
-                        if side == 1:
-                            sc_lo *= 0.5  # lo kept twice: halve its weight
-                        sc_hi = 1.0
-                        side = 1
-                    else:
-                        theta_lo = th
-                        e_lo[:] = e_try
-                        streak = streak + 1 if side == -1 else 1
-                        if side == -1:
-                            sc_hi *= 0.5  # hi kept twice: halve its weight
-                        sc_lo = 1.0
-                        side = -1
-                # accept the (tiny-violation) hi state
-                q1[:] = qb
-                qd1[:] = qdb
-                qdd1[:] = qddb
-                w1[:] = wb
-                wd1[:] = wdb
-                wdd1[:] = wddb
-                lam1[:] = lamb
-                s1[:] = sb
+                    _accept_trial(br, th, stuck, sig, lam1, N_e, s1, mus, tolF, e_try,
+                                  e_lo, e_hi, T1, S1, Tb, Sb)
+                theta_hi = _bracket_end(br, T1, S1, Tb, Sb)
             # --- accept the sub-step [tau, tau_end]
-            tau_end = tau + theta_hi * (1.0 - tau)
-            if any_ev and theta_hi < 1.0:
-                frac_end = tau_end
-            else:
-                frac_end = 1.0
-                tau_end = 1.0
+            tau_end = _substep_end(tau, theta_hi, any_ev)
+            n_sub += 1
             n_sub_total += 1
             if track_energy:
                 for i in range(n):
                     pe0[i] = _interp(pext[step, i], pext[step + 1, i], tau)
-                    pe1[i] = _interp(pext[step, i], pext[step + 1, i], frac_end)
+                    pe1[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
                 ag_a = _interp(ag[step], ag[step + 1], tau)
-                ag_b = _interp(ag[step], ag[step + 1], frac_end)
+                ag_b = _interp(ag[step], ag[step + 1], tau_end)
                 for i in range(n):
                     tmpn[i] = qd[i] + qd1[i]
                 _damp_mul(cd, Cq, diag, tmpn, tmpn2)
@@ -664,14 +471,9 @@ def run_kernel(
                     E_fric -= 0.5 * (lam[j] + lam1[j]) * (dwj - wk_v[j])
                 E_in += dq_in
                 E_damp += dd
-            q[:] = q1
-            qd[:] = qd1
-            qdd[:] = qdd1
-            w[:] = w1
-            wd[:] = wd1
-            wdd[:] = wdd1
-            lam[:] = lam1
-            if frac_end >= 1.0:
+            T0[:] = T1
+            S0[:] = S1
+            if tau_end >= 1.0:
                 if not full:
                     # a short final sub-step amplifies round-off in the Newmark acceleration
                     # update; restore accelerations from equilibrium (same forces lam)
@@ -680,82 +482,25 @@ def run_kernel(
                     _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag[step + 1], tmpn, lam,
                                  qdd, wdd)
                 break
-            # --- transition at t_e = (step + tau_end) dt
-            t_e = t_offset + (step + tau_end) * dt
-            ag_e = _interp(ag[step], ag[step + 1], tau_end)
-            for i in range(n):
-                tmpn[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
-            N_e = N[step] + tau_end * (N[step + 1] - N[step])
-            _event_values(stuck, sig, lam, N_e, s1, mus, e_try)
-            old_stuck = stuck.copy()
-            old_sig = sig.copy()
-            vn = np.empty(m)
-            _mv(P, qd, vn)
-            for j in range(m):
-                cand[j] = False
-                forced[j] = False
-                if old_stuck[j]:
-                    if e_try[j] > -1e-7 * mus[j] * N_e[j] - tolF[j]:
-                        forced[j] = True  # slip onset
-                        sig[j] = -1.0 if lam[j] > 0.0 else 1.0
-                    else:
-                        cand[j] = True  # stays at zero relative velocity
-                else:
-                    vs = abs(wd[j]) + abs(vn[j]) + 1e-30
-                    if e_try[j] > -1e-9 * vs:
-                        cand[j] = True  # relative velocity reached zero
-                        wd[j] = vn[j]
+            # --- transition at t_e = (step + tau_end) dt (§5)
+            ag_e = _sample(ag, pext, N, step, tau_end, tmpn, N_e)
+            _mv(P, qd, vn0)
+            _classify(stuck, sig, lam, s1, wd, vn0, mus, N_e, tolF, e_try, old_stuck, old_sig,
+                      cand, forced)
             _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag_e, tmpn, N_e,
                         stuck, sig, cand, forced, qdd, wdd, lam)
             cache_ok = False
-            for j in range(m):
-                kind = -1
-                if old_stuck[j] and not stuck[j]:
-                    kind = KIND_SLIP
-                elif (not old_stuck[j]) and stuck[j]:
-                    kind = KIND_STICK
-                elif (not old_stuck[j]) and (not stuck[j]) and sig[j] != old_sig[j]:
-                    kind = KIND_REVERSE
-                if kind >= 0:
-                    if n_ev < max_events:
-                        ev_time[n_ev] = t_e
-                        ev_slider[n_ev] = j
-                        ev_kind[n_ev] = kind
-                    n_ev += 1
+            n_ev = _record_events(old_stuck, old_sig, stuck, sig,
+                                  t_offset + (step + tau_end) * dt, n_ev, max_events,
+                                  ev_time, ev_slider, ev_kind)
             tau = tau_end
         if status != STATUS_OK:
             break
-        k = step + 1
-        out_q[k, :] = q
-        out_qd[k, :] = qd
-        out_qdd[k, :] = qdd
-        out_w[k, :] = w
-        out_wd[k, :] = wd
-        out_lam[k, :] = lam
-        for j in range(m):
-            out_stuck[k, j] = stuck[j]
-        if track_energy:
-            ke = 0.5 * np.dot(qd, qd)
-            for j in range(m):
-                ke += 0.5 * mass[j] * wd[j] * wd[j]
-            se = 0.0
-            for i in range(n):
-                se += 0.5 * kd[i] * q[i] * q[i]
-            out_energy[k, 0] = E_in
-            out_energy[k, 1] = ke
-            out_energy[k, 2] = se
-            out_energy[k, 3] = E_damp
-            out_energy[k, 4] = E_fric
-        if not np.isfinite(q[0]):
-            status = STATUS_NONFINITE
+        status = _write_output(step + 1, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy,
+                               E_in, E_damp, E_fric, out_q, out_qd, out_qdd, out_w, out_wd,
+                               out_lam, out_stuck, out_energy)
+        if status != STATUS_OK:
             break
-    if n_ev > max_events and status == STATUS_OK:
-        status = STATUS_EVENT_OVERFLOW
-    w_state[:] = w
-    wd_state[:] = wd
-    stuck_state[:] = stuck
-    sig_state[:] = sig
-    e_state[0] = E_in
-    e_state[1] = E_damp
-    e_state[2] = E_fric
+    status = _finish(status, n_ev, max_events, w, wd, stuck, sig, E_in, E_damp, E_fric,
+                     w_state, wd_state, stuck_state, sig_state, e_state)
     return status, n_ev, n_sub_total

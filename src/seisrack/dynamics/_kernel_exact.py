@@ -1,7 +1,8 @@
 """Exact-propagator stick–slip kernel (source shared by the numba and pure-Python backends).
 
-Loaded after ``_kernel.py`` in the same namespace (see :mod:`seisrack.dynamics.kernels`), so it
-reuses ``_mv``, ``_interp`` and ``_event_values`` from there.
+Loaded after ``_events.py`` and ``_kernel.py`` in the same namespace (see
+:mod:`seisrack.dynamics.kernels`), so it reuses ``_mv`` from the latter and the event core
+(detection, location, transitions, output) from the former.
 
 Between two contact events the system is linear and time-invariant: the structure plus the
 masses of the sliders that are stuck on it (they move with their support node), loaded by
@@ -24,19 +25,27 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_kernel.py``
     _consistent  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    from seisrack.dynamics._kernel import (  # noqa: F401
+    from seisrack.dynamics._events import (
         _JIT,
-        KIND_REVERSE,
-        KIND_SLIP,
-        KIND_STICK,
-        STATUS_EVENT_OVERFLOW,
-        STATUS_NONFINITE,
         STATUS_OK,
         STATUS_SUBSTEP_LIMIT,
-        _event_values,
-        _interp,
-        _mv,
+        _accept_trial,
+        _apply_candidates,
+        _bracket_end,
+        _bracket_start,
+        _classify,
+        _detect,
+        _event_buffers,
+        _finish,
+        _init_sliders,
+        _propose,
+        _record_events,
+        _release_worst,
+        _sample,
+        _substep_end,
+        _write_output,
     )
+    from seisrack.dynamics._kernel import _mv
 
 #: Gauss–Legendre 3-point nodes and weights on [0, 1] (energy quadrature)
 _GL_X = np.array([0.5 - 0.1 * np.sqrt(15.0), 0.5, 0.5 + 0.1 * np.sqrt(15.0)])
@@ -155,11 +164,7 @@ def _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag
     base = np.empty(r)
     for i in range(r):
         base[i] = pext[i] - cd[i] * qd[i] - w2[i] * q[i]
-    for j in range(m):
-        if cand[j]:
-            stuck[j] = True
-        elif forced[j]:
-            stuck[j] = False
+    _apply_candidates(cand, forced, stuck)
     Mt = Ms_key.copy()
     for j in range(m):
         if on_struct[j] and stuck[j] != key[j]:
@@ -185,22 +190,9 @@ def _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag
                     for i in range(r):
                         acc += P[j, i] * qdd[i]
                 lam[j] = mass[j] * (acc + ag)
-        worst = -1
-        worst_ratio = 1.0 + 1e-12
-        for j in range(m):
-            if stuck[j] and not forced[j]:
-                cap = mus[j] * N[j]
-                if cap <= 0.0:
-                    ratio = np.inf if lam[j] != 0.0 else 0.0
-                else:
-                    ratio = abs(lam[j]) / cap
-                if ratio > worst_ratio:
-                    worst_ratio = ratio
-                    worst = j
+        worst = _release_worst(stuck, forced, lam, mus, N, sig)
         if worst < 0:
             break
-        stuck[worst] = False
-        sig[worst] = -1.0 if lam[worst] > 0.0 else 1.0
         if on_struct[worst]:
             _rank1(Mt, P[worst], -mass[worst])
     for j in range(m):
@@ -531,27 +523,10 @@ def run_kernel_exact(
     qd = qd_init.copy()
     qdd = np.zeros(n)
     wdd = np.zeros(m)
-    lam = np.zeros(m)
-    forced = np.zeros(m, dtype=np.bool_)
-    if resume:
-        w = w_state.copy()
-        wd = wd_state.copy()
-        stuck = stuck_state.copy()
-        sig = sig_state.copy()
-        E_in = e_state[0]
-        E_damp = e_state[1]
-        E_fric = e_state[2]
-    else:
-        w = np.empty(m)
-        wd = np.empty(m)
-        _mv(P, q, w)
-        _mv(P, qd, wd)
-        stuck = np.ones(m, dtype=np.bool_)
-        sig = np.ones(m)
-        E_in = 0.0
-        E_damp = 0.0
-        E_fric = 0.0
-    cand = stuck.copy()
+    # slider state at the start of the (sub)step: S0 rows w, wd, lam, s
+    S0, stuck, sig, cand, forced, E_in, E_damp, E_fric = _init_sliders(
+        4, resume, P, q, qd, w_state, wd_state, stuck_state, sig_state, e_state)
+    w, wd, lam, s = S0[0], S0[1], S0[2], S0[3]
     # configuration mass of the stuck set ``key``, kept up to date by rank-one changes
     Ms_key = np.empty((n, n))
     _cfg_key(stuck, on_struct, key)
@@ -559,107 +534,54 @@ def run_kernel_exact(
     n_rank1 = 0
     _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag[0], pext[0],
                     N[0], stuck, sig, cand, forced, qdd, wdd, lam)
-    n_ev = 0
+    n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
+                          ev_time, ev_slider, ev_kind)
     status = STATUS_OK
-    for j in range(m):
-        if cand[j] and not stuck[j]:
-            if n_ev < max_events:
-                ev_time[n_ev] = t_offset
-                ev_slider[n_ev] = j
-                ev_kind[n_ev] = KIND_SLIP
-            n_ev += 1
     _cfg_key(stuck, on_struct, key)
     _cfg_mass(P, mass, key, Ms_key)
     slot, built = _find_config(key, Ms_key, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1,
                                fixed, pat, dt, c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E)
     n_built += 1
-    eta = np.empty(n)
-    etad = np.empty(n)
+    T0 = np.empty((3, n))  # eta, etad, g0 (modal loads at the start of a trial)
+    eta, etad, g0 = T0[0], T0[1], T0[2]
     _to_modal(c_psitm[slot], q, qd, eta, etad)
-    # buffers
-    eta1 = np.empty(n)
-    etad1 = np.empty(n)
+    # trial end state and its copy at the bracket's hi end
+    T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(3, n, 4, m)
+    eta1, etad1, g1 = T1[0], T1[1], T1[2]
+    w1, wd1, lam1, s1 = S1[0], S1[1], S1[2], S1[3]
     etadd = np.empty(n)
-    w1 = np.empty(m)
-    wd1 = np.empty(m)
-    lam1 = np.empty(m)
-    s1 = np.empty(m)
-    s = np.zeros(m)
-    g0 = np.empty(n)
-    g1 = np.empty(n)
-    etab = np.empty(n)
-    etadb = np.empty(n)
-    wb = np.empty(m)
-    wdb = np.empty(m)
-    lamb = np.empty(m)
-    sb = np.empty(m)
-    gb = np.empty(n)
-    e_lo = np.empty(m)
-    e_hi = np.empty(m)
-    e_try = np.empty(m)
-    tolF = np.empty(m)
     Esub = np.empty((n, 4))
-    ser0 = np.empty(npat)
-    ser1 = np.empty(npat)
-    sere = np.empty(npat)
-    pe_t = np.empty(n)
     ework = np.zeros(3)
-    vn = np.empty(m)
-    N0 = np.empty(m)
-    N_e = np.empty(m)
-    x0 = np.empty(n)
-    x1 = np.empty(n)
-    xd1 = np.empty(n)
-    xdd = np.empty(n)
-    fq = np.empty(n)
-    f0 = np.empty(n)
-    fs = np.empty(n)
+    Wp = np.empty((3, npat))  # scratch
+    ser0, ser1, sere = Wp[0], Wp[1], Wp[2]
+    Wn = np.empty((8, n))
+    pe_t, x0, x1, xd1, xdd, fq, f0, fs = Wn[0], Wn[1], Wn[2], Wn[3], Wn[4], Wn[5], Wn[6], Wn[7]
+    Wm = np.empty((3, m))
+    vn, N0, N_e = Wm[0], Wm[1], Wm[2]
     n_sub_total = 0
     _mv(P, qd, vn)
     for j in range(m):
         s[j] = wd[j] - vn[j]
 
-    out_q[0, :] = q
-    out_qd[0, :] = qd
-    out_qdd[0, :] = qdd
-    out_w[0, :] = w
-    out_wd[0, :] = wd
-    out_lam[0, :] = lam
-    for j in range(m):
-        out_stuck[0, j] = stuck[j]
-    if track_energy:
-        ke = 0.5 * np.dot(qd, qd)
-        for j in range(m):
-            ke += 0.5 * mass[j] * wd[j] * wd[j]
-        se = 0.0
-        for i in range(n):
-            se += 0.5 * w2[i] * q[i] * q[i]
-        out_energy[0, 0] = E_in
-        out_energy[0, 1] = ke
-        out_energy[0, 2] = se
-        out_energy[0, 3] = E_damp
-        out_energy[0, 4] = E_fric
+    _write_output(0, q, qd, qdd, w, wd, lam, stuck, mass, w2, track_energy, E_in, E_damp,
+                  E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
     for step in range(n_t - 1):
         tau = 0.0
         n_sub = 0
         while True:
-            n_sub += 1
-            if n_sub > max_substeps:
-                status = STATUS_SUBSTEP_LIMIT
-                break
-            full = tau == 0.0
-            hrem = (1.0 - tau) * dt
             nu2 = c_nu2[slot]
             cc = c_cc[slot]
             psi = c_psi[slot]
             gpat = c_gpat[slot]
+            if n_sub >= max_substeps:
+                status = STATUS_SUBSTEP_LIMIT
+                break
+            full = tau == 0.0
+            hrem = (1.0 - tau) * dt
+            ag0 = _sample(ag, series, N, step, tau, ser0, N0)
             for c in range(npat):
-                ser0[c] = _interp(series[step, c], series[step + 1, c], tau)
                 ser1[c] = series[step + 1, c]
-            ag0 = _interp(ag[step], ag[step + 1], tau)
             ag1 = ag[step + 1]
-            for j in range(m):
-                N0[j] = _interp(N[step, j], N[step + 1, j], tau)
             if full:
                 Eh = c_E[slot]
             else:
@@ -668,184 +590,60 @@ def run_kernel_exact(
             _trial_exact(hrem, Eh, psi, nu2, cc, P, gpat, mass, mud, on_struct,
                          stuck, sig, eta, etad, w, wd, ser0, ser1, ag0, ag1, N0, N[step + 1],
                          g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd, x0, x1, xd1, xdd, fq)
-            any_ev = False
-            for j in range(m):
-                n1 = N[step + 1, j]
-                if stuck[j]:
-                    tolF[j] = 1e-11 * mus[j] * max(N[step, j], n1) + 1e-300
-                    e_hi[j] = abs(lam1[j]) - mus[j] * n1
-                else:
-                    vscale = abs(wd1[j]) + abs(wd1[j] - s1[j]) + mud[j] * n1 / mass[j] * dt
-                    tolF[j] = 1e-9 * vscale
-                    e_hi[j] = -sig[j] * s1[j]
-                if e_hi[j] > tolF[j]:
-                    any_ev = True
+            any_ev = _detect(stuck, sig, mus, mud, mass, N[step], N[step + 1], lam1, wd1, s1,
+                             dt, tolF, e_hi)
             theta_hi = 1.0
-            frac_hi = 1.0
             if any_ev:
-                _event_values(stuck, sig, lam, N0, s, mus, e_lo)
-                theta_lo = 0.0
-                streak = 0
-                side = 0
-                sc_lo = 1.0
-                sc_hi = 1.0
-                etab[:] = eta1
-                etadb[:] = etad1
-                wb[:] = w1
-                wdb[:] = wd1
-                lamb[:] = lam1
-                sb[:] = s1
-                gb[:] = g1
+                _bracket_start(br, stuck, sig, lam, N0, s, mus, e_lo, T1, S1, Tb, Sb)
                 for _it in range(100):
-                    th = theta_hi
-                    jmin = -1
-                    for j in range(m):
-                        if e_hi[j] > tolF[j]:
-                            elo = min(e_lo[j] - tolF[j], 0.0) * sc_lo
-                            den = (e_hi[j] - tolF[j]) * sc_hi - elo
-                            frac = -elo / den if den > 0.0 else 0.0
-                            tj = theta_lo + frac * (theta_hi - theta_lo)
-                            if tj < th or jmin < 0:
-                                th = tj
-                                jmin = j
-                    if jmin < 0:
+                    th = _propose(br, stuck, e_lo, e_hi, tolF, mus, N[step + 1], hrem, dt)
+                    if th < 0.0:
                         break
-                    if stuck[jmin]:
-                        conv = e_hi[jmin] <= 1e-10 * mus[jmin] * N[step + 1, jmin] + tolF[jmin]
-                    else:
-                        conv = e_hi[jmin] <= 2.0 * tolF[jmin]
-                    span = theta_hi - theta_lo
-                    if conv or span * hrem <= 1e-12 * dt:
-                        break
-                    if streak >= 6:
-                        th = theta_lo + 0.5 * span
-                        streak = 0
-                    if th <= theta_lo + 1e-6 * span:
-                        th = theta_lo + 1e-6 * span
-                    if th >= theta_hi - 1e-6 * span:
-                        th = theta_hi - 1e-6 * span
                     hsub = th * hrem
-                    frac_end = tau + th * (1.0 - tau)
-                    for c in range(npat):
-                        sere[c] = _interp(series[step, c], series[step + 1, c], frac_end)
-                    ag_e = _interp(ag[step], ag[step + 1], frac_end)
-                    for j in range(m):
-                        N_e[j] = _interp(N[step, j], N[step + 1, j], frac_end)
                     _mode_matrices(nu2, cc, hsub, Esub)
+                    ag_e = _sample(ag, series, N, step, tau + th * (1.0 - tau), sere, N_e)
                     _trial_exact(hsub, Esub, psi, nu2, cc, P, gpat, mass, mud,
                                  on_struct, stuck, sig, eta, etad, w, wd, ser0, sere, ag0, ag_e,
                                  N0, N_e, g0, g1, eta1, etad1, w1, wd1, lam1, s1, etadd,
                                  x0, x1, xd1, xdd, fq)
-                    _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
-                    viol_try = False
-                    for j in range(m):
-                        if e_try[j] > tolF[j]:
-                            viol_try = True
-                    if viol_try:
-                        theta_hi = th
-                        e_hi[:] = e_try
-                        etab[:] = eta1
-                        etadb[:] = etad1
-                        wb[:] = w1
-                        wdb[:] = wd1
-                        lamb[:] = lam1
-                        sb[:] = s1
-                        gb[:] = g1
-                        streak = streak + 1 if side == 1 else 1
-                        if side == 1:
-                            sc_lo *= 0.5
-                        sc_hi = 1.0
-                        side = 1
-                    else:
-                        theta_lo = th
-                        e_lo[:] = e_try
-                        streak = streak + 1 if side == -1 else 1
-                        if side == -1:
-                            sc_hi *= 0.5
-                        sc_lo = 1.0
-                        side = -1
-                eta1[:] = etab
-                etad1[:] = etadb
-                w1[:] = wb
-                wd1[:] = wdb
-                lam1[:] = lamb
-                s1[:] = sb
-                g1[:] = gb
+                    _accept_trial(br, th, stuck, sig, lam1, N_e, s1, mus, tolF, e_try,
+                                  e_lo, e_hi, T1, S1, Tb, Sb)
                 # g0 was overwritten by identical values (same start state) in every trial
-            tau_end = tau + theta_hi * (1.0 - tau)
-            if any_ev and theta_hi < 1.0:
-                frac_hi = tau_end
-            else:
-                frac_hi = 1.0
-                tau_end = 1.0
-            h_acc = (frac_hi - tau) * dt
+                theta_hi = _bracket_end(br, T1, S1, Tb, Sb)
+            tau_end = _substep_end(tau, theta_hi, any_ev)
+            h_acc = (tau_end - tau) * dt
+            n_sub += 1
             n_sub_total += 1
             if track_energy:
-                if full and frac_hi >= 1.0:
+                if full and tau_end >= 1.0:
                     Eacc = c_E[slot]
                 else:
                     _mode_matrices(nu2, cc, h_acc, Esub)
                     Eacc = Esub
-                ag_b = _interp(ag[step], ag[step + 1], frac_hi)
-                for j in range(m):
-                    N_e[j] = _interp(N[step, j], N[step + 1, j], frac_hi)
+                ag_b = _sample(ag, pext, N, step, tau_end, pe_t, N_e)
                 _energy_substep(h_acc, Eacc, psi, nu2, cc, P, eta, etad, g0, g1, mass, mud,
                                 on_struct, stuck, sig, w, wd, ag0, ag_b, N0, N_e, ework,
                                 fq, f0, fs)
                 E_in += ework[0]
                 E_damp += ework[1]
                 E_fric += ework[2]
-            eta[:] = eta1
-            etad[:] = etad1
-            w[:] = w1
-            wd[:] = wd1
-            lam[:] = lam1
-            s[:] = s1
-            if frac_hi >= 1.0:
+            T0[:] = T1  # g0 <- g1: harmless, every trial recomputes g0
+            S0[:] = S1
+            if tau_end >= 1.0:
                 break
-            # --- transition at t_e = (step + tau_end) dt
-            t_e = t_offset + (step + tau_end) * dt
-            ag_e = _interp(ag[step], ag[step + 1], tau_end)
-            for i in range(n):
-                pe_t[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
-            for j in range(m):
-                N_e[j] = _interp(N[step, j], N[step + 1, j], tau_end)
+            # --- transition at t_e = (step + tau_end) dt (§5)
+            ag_e = _sample(ag, pext, N, step, tau_end, pe_t, N_e)
             _to_physical(c_psi[slot], eta, etad, q, qd)
-            _event_values(stuck, sig, lam, N_e, s, mus, e_try)
-            old_stuck = stuck.copy()
-            old_sig = sig.copy()
             _mv(P, qd, vn)
-            for j in range(m):
-                cand[j] = False
-                forced[j] = False
-                if old_stuck[j]:
-                    if e_try[j] > -1e-7 * mus[j] * N_e[j] - tolF[j]:
-                        forced[j] = True
-                        sig[j] = -1.0 if lam[j] > 0.0 else 1.0
-                    else:
-                        cand[j] = True
-                else:
-                    vs = abs(wd[j]) + abs(vn[j]) + 1e-30
-                    if e_try[j] > -1e-9 * vs:
-                        cand[j] = True
-                        wd[j] = vn[j]
+            _classify(stuck, sig, lam, s, wd, vn, mus, N_e, tolF, e_try, old_stuck, old_sig,
+                      cand, forced)
             _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag_e,
                             pe_t, N_e, stuck, sig, cand, forced, qdd, wdd, lam)
             for j in range(m):
                 s[j] = wd[j] - vn[j]
-                kind = -1
-                if old_stuck[j] and not stuck[j]:
-                    kind = KIND_SLIP
-                elif (not old_stuck[j]) and stuck[j]:
-                    kind = KIND_STICK
-                elif (not old_stuck[j]) and (not stuck[j]) and sig[j] != old_sig[j]:
-                    kind = KIND_REVERSE
-                if kind >= 0:
-                    if n_ev < max_events:
-                        ev_time[n_ev] = t_e
-                        ev_slider[n_ev] = j
-                        ev_kind[n_ev] = kind
-                    n_ev += 1
+            n_ev = _record_events(old_stuck, old_sig, stuck, sig,
+                                  t_offset + (step + tau_end) * dt, n_ev, max_events,
+                                  ev_time, ev_slider, ev_kind)
             changed = False
             for j in range(m):
                 if on_struct[j] and stuck[j] != old_stuck[j]:
@@ -875,36 +673,11 @@ def run_kernel_exact(
         for i in range(n):
             pe_t[i] = pext[k, i]
         _equilibrium_qdd(w2, cd, P, pe_t, q, qd, lam, qdd)
-        out_q[k, :] = q
-        out_qd[k, :] = qd
-        out_qdd[k, :] = qdd
-        out_w[k, :] = w
-        out_wd[k, :] = wd
-        out_lam[k, :] = lam
-        for j in range(m):
-            out_stuck[k, j] = stuck[j]
-        if track_energy:
-            ke = 0.5 * np.dot(qd, qd)
-            for j in range(m):
-                ke += 0.5 * mass[j] * wd[j] * wd[j]
-            se = 0.0
-            for i in range(n):
-                se += 0.5 * w2[i] * q[i] * q[i]
-            out_energy[k, 0] = E_in
-            out_energy[k, 1] = ke
-            out_energy[k, 2] = se
-            out_energy[k, 3] = E_damp
-            out_energy[k, 4] = E_fric
-        if not np.isfinite(q[0]):
-            status = STATUS_NONFINITE
+        status = _write_output(k, q, qd, qdd, w, wd, lam, stuck, mass, w2, track_energy, E_in,
+                               E_damp, E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam,
+                               out_stuck, out_energy)
+        if status != STATUS_OK:
             break
-    if n_ev > max_events and status == STATUS_OK:
-        status = STATUS_EVENT_OVERFLOW
-    w_state[:] = w
-    wd_state[:] = wd
-    stuck_state[:] = stuck
-    sig_state[:] = sig
-    e_state[0] = E_in
-    e_state[1] = E_damp
-    e_state[2] = E_fric
+    status = _finish(status, n_ev, max_events, w, wd, stuck, sig, E_in, E_damp, E_fric,
+                     w_state, wd_state, stuck_state, sig_state, e_state)
     return status, n_ev, n_sub_total, n_built

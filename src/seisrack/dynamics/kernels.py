@@ -1,8 +1,10 @@
 """Backends of the stick–slip kernel: the same source compiled by numba or run by CPython.
 
-``_kernel.py`` is the pure-Python twin; ``_kernel_numba.py`` executes the very same source with
-``_JIT = numba.njit``, so the two cannot drift apart (pystrata keeps such a twin to run the same
-validation under both). numba is optional; without it the Python backend is used.
+``_kernel.py`` (Newmark) and ``_kernel_exact.py`` (exact propagators) are the pure-Python twins;
+both take their event detection, location, transitions and output from ``_events.py``, the one
+event core every integrator shares. ``_kernel_numba.py`` executes the very same sources with
+``_JIT = numba.njit``, so the two backends cannot drift apart (pystrata keeps such a twin to run
+the same validation under both). numba is optional; without it the Python backend is used.
 """
 
 from __future__ import annotations
