@@ -236,7 +236,7 @@ def test_method_option(capsys, rec_csv):
 def test_basis_save_every_and_rigid_check(capsys, rec_csv):
     """--basis reduced stays within 0.5 % of the full basis on the paper rack; --save-every
     keeps fewer samples without changing a peak; --rigid-check takes alpha from a rigid run."""
-    full = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3")
+    full = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--basis", "full")
     red = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--basis", "reduced",
                 "--save-every", "10", "--rigid-check")
     assert full["basis"]["kind"] == "full" and red["basis"]["kind"] == "reduced"

@@ -18,9 +18,10 @@ paper rack, mu 0.3 (8 / 61)            2.0e-8      9.5e-8        2.7e-4    88 = 
 5 x 5 rack, mu 0.2 (40 / 641) [slow]   1.7e-6      4.1e-9        3.0e-5    168 vs 160
 =====================================  ==========  ============  ========  =========
 
-(Defaults: tol 3e-2, up to 8 Krylov blocks within 40 vectors. With 3 vectors the paper rack's
-base shear was 0.60 % off, which is why small structures get more blocks.) (The 3-level rack's sliding is only 1.65 µm; 6.9e-4 of it is 1 nm.) The 5 x 5 rack is slow
-because its full-basis reference (641 modes) takes ~50 s.
+(Defaults: tol 3e-2, up to 8 Krylov blocks within 40 vectors. With 3 vectors the paper
+rack's base shear was 0.60 % off, which is why small structures get more blocks.) The 3-level
+rack slides only 1.65 µm here. The 5 x 5 rack is slow because its full-basis reference
+(641 modes) takes ~50 s.
 """
 
 from __future__ import annotations

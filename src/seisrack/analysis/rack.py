@@ -294,7 +294,7 @@ def run_rack(
     progress: called with the number of analysis steps just completed, an increment (as
         ``tqdm.update`` expects), after each chunk of steps of the main run.
     method: time integration of :func:`seisrack.dynamics.simulate` ("auto", "exact" or
-        "newmark"); basis: its ``basis`` ("auto": every mode up to 300 DOFs, a reduced
+        "newmark"); basis: its ``basis`` ("auto": every mode up to 50 DOFs, a reduced
         load-dependent Ritz basis above).
     save_every: keep every k-th sample of the histories (``None``: first and last only, for
         studies); peaks are always taken over every step. max_memory: bytes the histories may

@@ -60,7 +60,7 @@ def register(subparsers: Any) -> None:
                         "acceleration, or auto (exact when it applies; default)")
     p.add_argument("--basis", choices=("auto", "full", "reduced"), default="auto",
                    help="structure basis: every mode (full), a load-dependent Ritz basis "
-                        "(reduced), or auto (full up to 300 DOFs; default)")
+                        "(reduced), or auto (full up to 50 DOFs; default)")
     p.add_argument("--save-every", type=int, default=1, metavar="K",
                    help="keep every K-th analysis step in the histories (peaks always use "
                         "every step; default 1)")

@@ -34,7 +34,7 @@ _LOG = logging.getLogger(__name__)
 #: can produce dozens of micro-events in one step on multi-pallet racks
 _MAX_SUBSTEPS = 512
 #: with ``basis="auto"``, structures up to this many DOFs keep every mode
-AUTO_FULL_MAX_DOF = 300
+AUTO_FULL_MAX_DOF = 50
 #: steps integrated per kernel call (bounded working memory; the state carries over exactly)
 DEFAULT_CHUNK = 20_000
 

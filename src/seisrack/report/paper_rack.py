@@ -126,8 +126,9 @@ def _run_set(spec: RackSpec, record: Record, t1: float, label: str,
     rigid_model = compile_rack(with_friction(spec, RIGID_MU))
     zeta = modal_damping(rigid_model, 2.0 * math.pi / t1)
     se = float(response_spectrum(record.accel, record.dt, np.array([t1]), zeta).psa[0])
-    rigid = run_rack(rigid_model, record, rigid_companion=False)
-    runs = {mu: run_rack(compile_rack(with_friction(spec, mu)), record, rigid_companion=False)
+    rigid = run_rack(rigid_model, record, rigid_companion=False, basis="full")
+    runs = {mu: run_rack(compile_rack(with_friction(spec, mu)), record,
+                         rigid_companion=False, basis="full")
             for mu in mus}
     return RackRun(label, record, zeta, se, rigid, runs)
 
@@ -138,7 +139,8 @@ def _bisect_onset(spec: RackSpec, record: Record, n_iter: int) -> dict[str, Any]
     runs = 0
     for _ in range(n_iter):
         mid = 0.5 * (lo + hi)
-        r = run_rack(compile_rack(with_friction(spec, mid)), record, rigid_companion=False)
+        r = run_rack(compile_rack(with_friction(spec, mid)), record, rigid_companion=False,
+                     basis="full")
         runs += 1
         if r.sliding_occurred():
             lo = mid
