@@ -425,7 +425,7 @@ def report(env: dict, load0: tuple, load1: tuple, base: dict, paper: dict, ladde
     if len(red) >= 2:
         a("")
         a(f"The same fit over the {len(red)} sizes that ran on the reduced (Ritz) basis only "
-          f"(`basis=\"auto\"` keeps every mode up to 300 DOFs): "
+          f"(`basis=\"auto\"` keeps every mode up to 50 DOFs): "
           f"**{fit_exponent(*zip(*red, strict=True)):.2f}**. Run time follows the number of "
           "slip events and configurations more than the pallet count: the taller ladder "
           "racks are softer and fewer of their pallets slide.")
