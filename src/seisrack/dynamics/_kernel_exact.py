@@ -1,8 +1,9 @@
 """Exact-propagator stick–slip kernel (source shared by the numba and pure-Python backends).
 
-Loaded after ``_events.py`` and ``_kernel.py`` in the same namespace (see
-:mod:`seisrack.dynamics.kernels`), so it reuses ``_mv`` from the latter and the event core
-(detection, location, transitions, output) from the former.
+Loaded after ``_events.py``, ``_kernel.py``, ``_exact_modes.py`` and ``_exact_config.py`` in
+the same namespace (see :mod:`seisrack.dynamics.kernels`): it reuses the event core
+(detection, location, transitions, output), ``_mv``, the modal propagators and the
+configuration handling from them; this part holds the trial step and the main loop.
 
 Between two contact events the system is linear and time-invariant: the structure plus the
 masses of the sliders that are stuck on it (they move with their support node), loaded by
@@ -30,7 +31,6 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         STATUS_OK,
         STATUS_SUBSTEP_LIMIT,
         _accept_trial,
-        _apply_candidates,
         _bracket_end,
         _bracket_start,
         _classify,
@@ -40,234 +40,19 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _init_sliders,
         _propose,
         _record_events,
-        _release_worst,
         _sample,
         _substep_end,
         _write_output,
     )
-    from seisrack.dynamics._kernel import _mv
-
-#: Gauss–Legendre 3-point nodes and weights on [0, 1] (energy quadrature)
-_GL_X = np.array([0.5 - 0.1 * np.sqrt(15.0), 0.5, 0.5 + 0.1 * np.sqrt(15.0)])
-_GL_W = np.array([5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0])
-
-
-@_JIT
-def _mode_matrix(nu2, c, h, E):
-    """Homogeneous propagator of y'' + c y' + nu2 y = 0 over h: E = (E00, E01, E10, E11).
-
-    One formula for every damping regime: with a = c/2 and b² = nu2 - a², the solution is
-    e^{-a t} (C(t) y0 + S(t) (y0' + a y0)) with C = cos/cosh/1 and S = sin(bt)/b, sinh/b or t.
-    Overdamped stiff modes are evaluated as sums of decaying exponentials (no overflow).
-    """
-    a = 0.5 * c
-    b2 = nu2 - a * a
-    x = b2 * h * h
-    if abs(x) < 1e-3:
-        # series in b² h² (cos / cosh and sin/b / sinh/b share it)
-        eC = 1.0 - x / 2.0 + x * x / 24.0 - x * x * x / 720.0
-        eS = h * (1.0 - x / 6.0 + x * x / 120.0 - x * x * x / 5040.0)
-        ea = np.exp(-a * h)
-        eC *= ea
-        eS *= ea
-    elif b2 > 0.0:
-        b = np.sqrt(b2)
-        ea = np.exp(-a * h)
-        eC = ea * np.cos(b * h)
-        eS = ea * np.sin(b * h) / b
-    else:
-        b = np.sqrt(-b2)
-        # a - b >= 0 computed without cancellation: (a - b) = nu2 / (a + b)
-        slow = nu2 / (a + b)
-        e1 = np.exp(-slow * h)
-        e2 = np.exp(-(a + b) * h)
-        eC = 0.5 * (e1 + e2)
-        eS = 0.5 * (e1 - e2) / b
-    E[0] = eC + a * eS
-    E[1] = eS
-    E[2] = -nu2 * eS
-    E[3] = eC - a * eS
-
-
-@_JIT
-def _mode_matrices(nu2, cc, h, E):
-    for k in range(nu2.shape[0]):
-        _mode_matrix(nu2[k], cc[k], h, E[k])
-
-
-@_JIT
-def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
-    """Exact modal step: loads g linear from g0 to g1 over h; E from ``_mode_matrices(h)``."""
-    for k in range(nu2.shape[0]):
-        s = (g1[k] - g0[k]) / h
-        B = s / nu2[k]
-        A = (g0[k] - cc[k] * B) / nu2[k]
-        y = eta0[k] - A
-        yd = etad0[k] - B
-        eta1[k] = A + B * h + E[k, 0] * y + E[k, 1] * yd
-        etad1[k] = B + E[k, 2] * y + E[k, 3] * yd
-
-
-@_JIT
-def _rank1(Ms, p, c):
-    """Ms += c p pᵀ (a slider of mass c sticking, or -c unsticking)."""
-    r = p.shape[0]
-    for i in range(r):
-        pi = c * p[i]
-        if pi != 0.0:
-            for k in range(r):
-                Ms[i, k] += pi * p[k]
-
-
-@_JIT
-def _cfg_mass(P, mass, key, Ms):
-    """Ms = I + P_Sᵀ diag(m_S) P_S for the stuck set ``key`` (from scratch)."""
-    r = P.shape[1]
-    for i in range(r):
-        for k in range(r):
-            Ms[i, k] = 0.0
-        Ms[i, i] = 1.0
-    for j in range(P.shape[0]):
-        if key[j]:
-            _rank1(Ms, P[j], mass[j])
-
-
-@_JIT
-def _spd_solve(A, b, x):
-    """x = A⁻¹ b for a small symmetric positive-definite A (Cholesky)."""
-    r = A.shape[0]
-    L = np.linalg.cholesky(A)
-    for i in range(r):
-        acc = b[i]
-        for k in range(i):
-            acc -= L[i, k] * x[k]
-        x[i] = acc / L[i, i]
-    for i in range(r - 1, -1, -1):
-        acc = x[i]
-        for k in range(i + 1, r):
-            acc -= L[k, i] * x[k]
-        x[i] = acc / L[i, i]
-
-
-@_JIT
-def _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag, pext, N,
-                    stuck, sig, cand, forced, qdd, wdd, lam):
-    """Decide the contact state at an instant and compute consistent accelerations.
-
-    Same decision rule as ``_consistent`` (stick every candidate, release the most overloaded
-    stuck slider one at a time), solved in the structure's coordinates: the stuck sliders'
-    masses join the configuration mass ``I + P_Sᵀ m_S P_S`` (rank-one changes from ``Ms_key``,
-    the mass of the stuck set ``key``), so the cost is O(m r + r³), never O(m²).
-    """
-    r = w2.shape[0]
-    m = mass.shape[0]
-    base = np.empty(r)
-    for i in range(r):
-        base[i] = pext[i] - cd[i] * qd[i] - w2[i] * q[i]
-    _apply_candidates(cand, forced, stuck)
-    Mt = Ms_key.copy()
-    for j in range(m):
-        if on_struct[j] and stuck[j] != key[j]:
-            _rank1(Mt, P[j], mass[j] if stuck[j] else -mass[j])
-    rhs = np.empty(r)
-    for _it in range(2 * m + 2):
-        for i in range(r):
-            rhs[i] = base[i]
-        for j in range(m):
-            if stuck[j]:
-                f = -mass[j] * ag
-            else:
-                lam[j] = -mud[j] * N[j] * sig[j]
-                f = -lam[j]
-            if on_struct[j] and f != 0.0:
-                for i in range(r):
-                    rhs[i] += P[j, i] * f
-        _spd_solve(Mt, rhs, qdd)
-        for j in range(m):
-            if stuck[j]:
-                acc = 0.0
-                if on_struct[j]:
-                    for i in range(r):
-                        acc += P[j, i] * qdd[i]
-                lam[j] = mass[j] * (acc + ag)
-        worst = _release_worst(stuck, forced, lam, mus, N, sig)
-        if worst < 0:
-            break
-        if on_struct[worst]:
-            _rank1(Mt, P[worst], -mass[worst])
-    for j in range(m):
-        wdd[j] = -ag + lam[j] / mass[j]
-
-
-@_JIT
-def _build_config(slot, key, Ms, w2, cd, a1, fixed, pat, dt,
-                  c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E):
-    """Modes of the structure with the sliders of ``key`` stuck on it (configuration mass
-    ``Ms``), and the operators derived from them. Cost O(r³), independent of the slider count."""
-    n = w2.shape[0]
-    any_stuck = False
-    for j in range(key.shape[0]):
-        if key[j]:
-            any_stuck = True
-    if fixed or not any_stuck:
-        psi = np.eye(n)
-        nu2 = w2.copy()
-        cc = cd.copy()
-        psitm = np.eye(n)
-    else:
-        L = np.linalg.cholesky(Ms)
-        Linv = np.linalg.inv(L)
-        A = (Linv * w2) @ Linv.T
-        A = 0.5 * (A + A.T)
-        nu2, Y = np.linalg.eigh(A)
-        psi = Linv.T @ Y
-        cc = a1 * nu2
-        psitm = psi.T @ Ms
-    scale = max(np.max(np.abs(nu2)), 1e-300)
-    for k in range(n):
-        if nu2[k] < 1e-14 * scale:
-            nu2[k] = 1e-14 * scale
-    c_psi[slot] = psi
-    c_psitm[slot] = psitm
-    c_nu2[slot] = nu2
-    c_cc[slot] = cc
-    c_gpat[slot] = psi.T @ pat.T
-    _mode_matrices(nu2, cc, dt, c_E[slot])
-
-
-@_JIT
-def _find_config(key, Ms, cfg_key, cfg_valid, cfg_stamp, stamp, w2, cd, a1, fixed, pat, dt,
-                 c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E):
-    """Slot of the configuration ``key`` in the cache (built on a miss; LRU eviction)."""
-    cap = cfg_key.shape[0]
-    m = key.shape[0]
-    for s in range(cap):
-        if cfg_valid[s]:
-            same = True
-            for j in range(m):
-                if cfg_key[s, j] != key[j]:
-                    same = False
-                    break
-            if same:
-                cfg_stamp[s] = stamp
-                return s, False
-    slot = 0
-    oldest = cfg_stamp[0] if cfg_valid[0] else -1
-    for s in range(cap):
-        if not cfg_valid[s]:
-            slot = s
-            break
-        if cfg_stamp[s] < oldest:
-            oldest = cfg_stamp[s]
-            slot = s
-    _build_config(slot, key, Ms, w2, cd, a1, fixed, pat, dt,
-                  c_psi, c_psitm, c_nu2, c_cc, c_gpat, c_E)
-    for j in range(m):
-        cfg_key[slot, j] = key[j]
-    cfg_valid[slot] = True
-    cfg_stamp[slot] = stamp
-    return slot, True
-
+    from seisrack.dynamics._exact_config import (
+        _cfg_key,
+        _cfg_mass,
+        _consistent_cfg,
+        _find_config,
+        _rank1,
+    )
+    from seisrack.dynamics._exact_modes import _energy_substep, _mode_matrices, _propagate
+    from seisrack.dynamics._linalg import _mv
 
 @_JIT
 def _slider_load(P, series_t, ag_t, N_t, mass, mud, stuck, sig, on_struct, fq):
@@ -376,107 +161,6 @@ def _equilibrium_qdd(w2, cd, P, pext_t, q, qd, lam, qdd):
         for j in range(m):
             acc -= P[j, i] * lam[j]
         qdd[i] = acc
-
-
-@_JIT
-def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_struct, stuck,
-                    sig, w0, wd0, ag0, ag1, N0, N1, out, fq, f0, fs):
-    """Input, damping and friction work over a sub-step, in closed form.
-
-    Per mode (η̈ + c η̇ + ν² η = g0 + s τ, particular part A + B τ, homogeneous part y):
-    ∫ (l0 + l1 τ) η̇ dτ = l0 Δη + l1 (h η(h) - ∫η), with ∫y = -(Δẏ + c Δy)/ν² from the mode
-    equation, and c ∫ η̇² = c B² h + 2 c B Δy + x0ᵀ (c W) x0, where W is the 2x2 Gramian
-    ∫ e^{Jᵀτ} e2 e2ᵀ e^{Jτ} dτ solved from its Lyapunov equation (written for c W, so that an
-    undamped mode gives 0 without dividing by c). Slider terms are polynomials in τ
-    (3-point Gauss–Legendre is exact for them). Powers: gᵀη̇ is the structural input (it
-    includes the stuck sliders' inertia); the sliding forces inside g are moved to friction.
-    """
-    n = nu2.shape[0]
-    m = mass.shape[0]
-    e_in = 0.0
-    e_d = 0.0
-    e_f = 0.0
-    # sliding forces on the structure, λ_j(τ) = l0_j + ls_j τ, as modal loads f0 + fs τ
-    r_ = fq.shape[0]
-    for i in range(r_):
-        fq[i] = 0.0
-    for j in range(m):
-        if on_struct[j] and not stuck[j]:
-            l0 = -mud[j] * N0[j] * sig[j]
-            for i in range(r_):
-                fq[i] += P[j, i] * l0
-    for k in range(n):
-        acc = 0.0
-        for i in range(r_):
-            acc += psi[i, k] * fq[i]
-        f0[k] = acc
-    for i in range(r_):
-        fq[i] = 0.0
-    for j in range(m):
-        if on_struct[j] and not stuck[j]:
-            ls = -mud[j] * (N1[j] - N0[j]) * sig[j] / h
-            for i in range(r_):
-                fq[i] += P[j, i] * ls
-    for k in range(n):
-        acc = 0.0
-        for i in range(r_):
-            acc += psi[i, k] * fq[i]
-        fs[k] = acc
-    for k in range(n):
-        c = cc[k]
-        w = nu2[k]
-        s = (g1[k] - g0[k]) / h
-        B = s / w
-        A = (g0[k] - c * B) / w
-        y0 = eta0[k] - A
-        yd0 = etad0[k] - B
-        y1 = Eh[k, 0] * y0 + Eh[k, 1] * yd0
-        yd1 = Eh[k, 2] * y0 + Eh[k, 3] * yd0
-        eta_h = A + B * h + y1
-        d_eta = eta_h - eta0[k]
-        int_y = -((yd1 - yd0) + c * (y1 - y0)) / w
-        int_eta = A * h + 0.5 * B * h * h + int_y
-        mom = h * eta_h - int_eta  # ∫ τ η̇ dτ
-        e_in += g0[k] * d_eta + s * mom
-        # damping: c ∫ η̇² = c B² h + 2 c B (y1 - y0) + x0ᵀ (cW) x0
-        if c != 0.0:
-            R11 = Eh[k, 2] * Eh[k, 2]
-            R12 = Eh[k, 2] * Eh[k, 3]
-            R22 = Eh[k, 3] * Eh[k, 3] - 1.0
-            w12 = -R11 / (2.0 * w)
-            cw22 = w12 - 0.5 * R22
-            cw12 = c * w12
-            cw11 = c * R12 + w * cw22 + c * c * w12
-            e_d += (c * B * B * h + 2.0 * c * B * (y1 - y0)
-                    + cw11 * y0 * y0 + 2.0 * cw12 * y0 * yd0 + cw22 * yd0 * yd0)
-        # sliding forces on the structure: their power leaves the input, enters friction
-        work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
-        e_in += work
-        e_f += work
-    for j in range(m):
-        if stuck[j]:
-            continue  # stuck on the structure: inside g; stuck on the ground: no motion
-        l0 = -mud[j] * N0[j] * sig[j]
-        l1 = -mud[j] * N1[j] * sig[j]
-        a0 = -ag0 + l0 / mass[j]
-        for p in range(3):
-            x = _GL_X[p]
-            tau = x * h
-            wgt = _GL_W[p] * h
-            ag_t = ag0 + x * (ag1 - ag0)
-            lam_t = l0 + x * (l1 - l0)
-            wd_t = wd0[j] + 0.5 * tau * (a0 + (-ag_t + lam_t / mass[j]))
-            e_in -= wgt * mass[j] * ag_t * wd_t
-            e_f -= wgt * lam_t * wd_t
-    out[0] = e_in
-    out[1] = e_d
-    out[2] = e_f
-
-
-@_JIT
-def _cfg_key(stuck, on_struct, key):
-    for j in range(stuck.shape[0]):
-        key[j] = stuck[j] and on_struct[j]
 
 
 @_JIT

@@ -1,0 +1,124 @@
+"""Small dense linear algebra of the Newmark kernel, hand-written for numba's nopython mode
+(no BLAS/LAPACK wrappers on tiny matrices, one specialisation per layout). Source shared by the
+numba and pure-Python backends (executed after ``_events.py``)."""
+
+# ruff: noqa: N803, N806  (matrix names follow the equations)
+
+import numpy as np
+
+try:  # names injected by the loader
+    _JIT  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._events import _JIT
+
+@_JIT
+def _solve(A, B):
+    """Solve A X = B by Gaussian elimination with partial pivoting; A (k, k), B (k, r).
+
+    Hand-written (instead of np.linalg) to keep numba compile times short; k is small here
+    (number of stuck sliders) or the modal size for non-classical damping only.
+    """
+    k = A.shape[0]
+    r = B.shape[1]
+    a = A.copy()
+    x = B.copy()
+    for c in range(k):
+        piv = c
+        big = abs(a[c, c])
+        for i in range(c + 1, k):
+            if abs(a[i, c]) > big:
+                big = abs(a[i, c])
+                piv = i
+        if piv != c:
+            for j in range(k):
+                tmp = a[c, j]
+                a[c, j] = a[piv, j]
+                a[piv, j] = tmp
+            for j in range(r):
+                tmp = x[c, j]
+                x[c, j] = x[piv, j]
+                x[piv, j] = tmp
+        d = a[c, c]
+        for i in range(c + 1, k):
+            f = a[i, c] / d
+            if f != 0.0:
+                for j in range(c, k):
+                    a[i, j] -= f * a[c, j]
+                for j in range(r):
+                    x[i, j] -= f * x[c, j]
+    for c in range(k - 1, -1, -1):
+        for j in range(r):
+            acc = x[c, j]
+            for i in range(c + 1, k):
+                acc -= a[c, i] * x[i, j]
+            x[c, j] = acc / a[c, c]
+    return x
+
+
+@_JIT
+def _mm_pt(A, P):
+    """A @ P.T for A (k, n), P (m, n): shape (k, m)."""
+    k = A.shape[0]
+    m = P.shape[0]
+    n = P.shape[1]
+    out = np.empty((k, m))
+    for i in range(k):
+        for j in range(m):
+            acc = 0.0
+            for t in range(n):
+                acc += A[i, t] * P[j, t]
+            out[i, j] = acc
+    return out
+
+
+@_JIT
+def _modal_solve(kd, cd, Cq, diag, h, rhs, out):
+    """Solve (K + 2/h C + 4/h^2 I) x = rhs for x (mass is identity in modal coordinates)."""
+    n = kd.shape[0]
+    if diag:
+        for i in range(n):
+            out[i] = rhs[i] / (kd[i] + 2.0 / h * cd[i] + 4.0 / (h * h))
+    else:
+        Kh = (2.0 / h) * Cq.copy()
+        for i in range(n):
+            Kh[i, i] += kd[i] + 4.0 / (h * h)
+        x = _solve(Kh, rhs.reshape((n, 1)))
+        for i in range(n):
+            out[i] = x[i, 0]
+
+
+@_JIT
+def _hmat_pt(kd, cd, Cq, diag, h, P):
+    """Return H P^T, with H = (K + 2/h C + 4/h^2 I)^-1: shape (n, m)."""
+    n = kd.shape[0]
+    m = P.shape[0]
+    if diag:
+        HPt = np.empty((n, m))
+        for i in range(n):
+            hi = 1.0 / (kd[i] + 2.0 / h * cd[i] + 4.0 / (h * h))
+            for j in range(m):
+                HPt[i, j] = hi * P[j, i]
+        return HPt
+    Kh = (2.0 / h) * Cq.copy()
+    for i in range(n):
+        Kh[i, i] += kd[i] + 4.0 / (h * h)
+    return _solve(Kh, np.ascontiguousarray(P.T))
+
+
+@_JIT
+def _damp_mul(cd, Cq, diag, x, out):
+    if diag:
+        for i in range(x.shape[0]):
+            out[i] = cd[i] * x[i]
+    else:
+        _mv(Cq, x, out)
+
+
+@_JIT
+def _mv(A, x, out):
+    """out = A @ x with explicit loops (faster than BLAS for the small sizes used per step)."""
+    for i in range(A.shape[0]):
+        acc = 0.0
+        for k in range(A.shape[1]):
+            acc += A[i, k] * x[k]
+        out[i] = acc
