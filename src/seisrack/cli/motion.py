@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -43,16 +44,30 @@ def register(subparsers: Any) -> None:
     s.add_argument("--plot", help="PNG: accelerogram and spectrum")
     s.set_defaults(func=_spectrum)
 
-    c = sub.add_parser("check", help="EN 1998-1 §3.2.3.1.2 report for a suite of records")
-    c.add_argument("files", nargs="+")
-    c.add_argument("--units", help="'g' or 'm/s2' (needed unless .AT2 or seisrack CSV)")
-    c.add_argument("--dt", type=float)
+    c = sub.add_parser(
+        "check", help="EN 1998-1 §3.2.3.1.2 report for a suite of records (files or folders)",
+        description="Check a suite of accelerograms against EN 1998-1 §3.2.3.1.2: at least 3 "
+                    "records, mean PGA >= ag·S, mean 5%%-damped spectrum >= 90%% of the elastic "
+                    "spectrum over 0.2 T1 - 2 T1, stationary part >= 10 s. Reports the smallest "
+                    "common scale factor meeting the PGA and spectrum rules.")
+    c.add_argument("files", nargs="+",
+                   help="record files and/or folders (a folder contributes its .AT2, .csv and "
+                        ".txt files)")
+    c.add_argument("--units", help="'g' or 'm/s2' for files that do not declare them (.AT2 "
+                                   "files are in g, seisrack CSV files in m/s2)")
+    c.add_argument("--dt", type=float, help="[s] time step of one-column files")
     c.add_argument("--type", type=int, choices=[1, 2], required=True)
     c.add_argument("--ground", choices=list("ABCDE"), required=True)
     c.add_argument("--ag", type=float, required=True, help="[g]")
     c.add_argument("--importance", type=float, default=1.0)
     c.add_argument("--damping", type=float, default=0.05)
-    c.add_argument("--period", type=float, required=True, help="fundamental period T1 [s]")
+    per = c.add_mutually_exclusive_group(required=True)
+    per.add_argument("--period", type=float, help="fundamental period T1 [s]")
+    per.add_argument("--rack", metavar="RACK.toml",
+                     help="take T1 from the modal analysis of this rack")
+    c.add_argument("--scale-suite", action="store_true",
+                   help="multiply every record by the reported common factor and report the "
+                        "scaled suite")
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=_check)
 
@@ -149,17 +164,44 @@ def _spectrum(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
-    from seisrack.motion import check_ec8_suite, ec8_spectrum, read_record
+    from seisrack.errors import InputError
+    from seisrack.motion import check_ec8_suite, ec8_spectrum, read_suite, scale_by
 
-    recs = [read_record(f, units=args.units, dt=args.dt) for f in args.files]
+    if args.period is not None and not (math.isfinite(args.period) and args.period > 0):
+        raise InputError("--period", args.period, "a fundamental period T1 > 0 s")
+    recs = read_suite(args.files, units=args.units, dt=args.dt)
+    period = args.period if args.period is not None else _rack_period(args.rack)
     target = ec8_spectrum(args.type, args.ground, args.ag, damping=args.damping,
                           importance=args.importance)
-    rep = check_ec8_suite(recs, target, args.period)
+    rep = check_ec8_suite(recs, target, period)
+    scaled = None
+    if args.scale_suite:
+        if not (math.isfinite(rep.scale_factor) and rep.scale_factor > 0):
+            raise InputError("--scale-suite", True, "a suite with a non-zero mean spectrum",
+                             hint="No common factor can make this suite comply")
+        factor = rep.scale_factor
+        scaled = check_ec8_suite([scale_by(r, factor) for r in recs], target, period)
     if args.json:
         d = rep.to_dict()
-        d["target"] = target.name
+        d.update(target=target.name, ag_S_m_s2=target.pga, period_s=period,
+                 files=[r.provenance for r in recs])
+        if scaled is not None:
+            d["scaled"] = {"factor": rep.scale_factor, **scaled.to_dict()}
         print_json(d)
     else:
-        print(f"target: {target.name}, ag·S = {target.pga:.4g} m/s2, T1 = {args.period:g} s")
+        print(f"target: {target.name}, ag·S = {target.pga:.4g} m/s2, T1 = {period:.4g} s, "
+              f"{len(recs)} records")
         print(rep.text())
-    return 0 if rep.passed else 1
+        if scaled is not None:
+            print(f"\nafter scaling every record by {rep.scale_factor:.4g}:")
+            print(scaled.text())
+    final = scaled if scaled is not None else rep
+    return 0 if final.passed else 1
+
+
+def _rack_period(path: str) -> float:
+    """[s] first period of the rack in ``path`` (pallets rigidly attached)."""
+    from seisrack.fe.modal import modal_analysis
+    from seisrack.model import compile_rack, load_rack
+
+    return float(modal_analysis(compile_rack(load_rack(path)), n_modes=1).periods[0])

@@ -74,7 +74,25 @@ def register(subparsers: Any) -> None:
                    help="write the Fig. 16a-d PNGs into --out DIR (default: yes with --out)")
     p.add_argument("--json", action="store_true",
                    help="print one JSON object (the summary) instead of the text report")
+    _register_scaling(p)
     p.set_defaults(func=run)
+
+
+def _register_scaling(p: argparse.ArgumentParser) -> None:
+    grp = p.add_argument_group(
+        "record scaling (at most one; the vertical record gets the same factor)")
+    sc = grp.add_mutually_exclusive_group()
+    sc.add_argument("--scale-pga", type=float, metavar="VALUE",
+                    help="scale the record to this peak ground acceleration (m/s², or g with "
+                         "--scale-units g)")
+    sc.add_argument("--scale-sa", nargs=2, metavar=("T", "VALUE"),
+                    help="scale the record so that its 5%%-damped pseudo-spectral acceleration "
+                         "at period T [s] (0.01-10 s, or T1: the rack's first period) is VALUE "
+                         "(m/s², or g with --scale-units g)")
+    sc.add_argument("--scale", type=float, metavar="FACTOR",
+                    help="multiply the record by FACTOR (> 0)")
+    grp.add_argument("--scale-units", choices=("m/s2", "g"), default="m/s2",
+                     help="units of the VALUE of --scale-pga / --scale-sa (default m/s2)")
 
 
 # ------------------------------------------------------------------------------ validation
@@ -185,8 +203,64 @@ def _need(module: str, option: str, value: Any, extra: str) -> None:
                          hint=f"Install it with: pip install 'seisrack[{extra}]'") from None
 
 
+# ------------------------------------------------------------------------------ scaling
+#: [m/s²] a scaled PGA above this draws a warning (issue #14: implausible input)
+PGA_WARN = 3.0 * 9.80665
+
+
+def _apply_scaling(args: argparse.Namespace, model: Any, rec: Any,
+                   vert: Any) -> tuple[Any, Any, dict[str, Any] | None]:
+    """Scale the horizontal record (and the vertical one by the same factor) as asked."""
+    from seisrack.errors import InputError
+    from seisrack.motion import G, scale_by
+    from seisrack.motion.scaling import check_period, scale_record
+
+    unit = G if args.scale_units == "g" else 1.0
+    kw: dict[str, Any] = {}
+    if args.scale_pga is not None:
+        _check_number("--scale-pga", args.scale_pga, f"a target PGA > 0 {args.scale_units}",
+                      args.scale_pga > 0)
+        kw["pga"] = args.scale_pga * unit
+    elif args.scale_sa is not None:
+        t_txt, v_txt = args.scale_sa
+        try:
+            value = float(v_txt)
+        except ValueError:
+            raise InputError("--scale-sa VALUE", v_txt, "a spectral acceleration > 0") from None
+        _check_number("--scale-sa VALUE", value, f"a target Sa > 0 {args.scale_units}",
+                      value > 0)
+        if t_txt.strip().lower() == "t1":
+            from seisrack.fe.modal import modal_analysis
+
+            kw["period"] = float(modal_analysis(model, n_modes=1).periods[0])
+        else:
+            try:
+                period = float(t_txt)
+            except ValueError:
+                raise InputError("--scale-sa T", t_txt, "a period [s] or the word T1") from None
+            kw["period"] = check_period(period, "--scale-sa T")
+        kw["sa"] = value * unit
+    elif args.scale is not None:
+        _check_number("--scale", args.scale, "a scale factor > 0", args.scale > 0)
+        kw["factor"] = args.scale
+    else:
+        return rec, vert, None
+    new, info = scale_record(rec, **kw)
+    if args.scale_sa is not None:
+        info["period_from"] = "T1" if args.scale_sa[0].strip().lower() == "t1" else "given"
+    if vert is not None:
+        vert = scale_by(vert, info["factor"])
+        info["vertical_pga_after"] = vert.pga
+    if new.pga > PGA_WARN:
+        print(f"seisrack: warning: the scaled record's PGA is {new.pga:.3g} m/s² = "
+              f"{new.pga / G:.2f} g, above 3 g; check the scaling target", file=sys.stderr)
+    return new, vert, info
+
+
 # ------------------------------------------------------------------------------ run
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from seisrack.analysis import analysis_grid, run_rack
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
@@ -198,6 +272,7 @@ def run(args: argparse.Namespace) -> int:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
     model = compile_rack(spec)
     rec, vert = _records(args)
+    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
     try:
         k = analysis_grid(rec, args.dt)
     except InputError as exc:
@@ -226,6 +301,9 @@ def run(args: argparse.Namespace) -> int:
     summary = resp.summary()
     summary = {"rack": args.rack, "title": spec.title, **summary,
                "integration": resp.history.method, "basis": resp.history.basis}
+    if scaling is not None:
+        scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
+        summary["scaling"] = scaling
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot)  # adds summary["outputs"]
     if args.json:
@@ -279,6 +357,13 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
     lines.append(
         f"record: {rec.name} ({rec.n} samples, dt {rec.dt:g} s, PGA {rec.pga:.3f} m/s² = "
         f"{rec.pga / 9.80665:.3f} g)" + (f", vertical: {vert.name}" if vert is not None else ""))
+    sc = summary.get("scaling")
+    if sc is not None:
+        how = {"pga": f"to PGA {sc['target']:.4g} m/s²",
+               "sa": f"to Sa({sc.get('period_s', 0):.4g} s) = {sc['target']:.4g} m/s²",
+               "factor": "by a given factor"}[sc["method"]]
+        lines.append(f"scaling: {how}, factor {sc['factor']:.6g} (PGA {sc['pga_before']:.4g} "
+                     f"-> {sc['pga_after']:.4g} m/s²)")
     lines.append(f"analysis: dt {resp.dt:g} s, {resp.t.size - 1} steps, {resp.t[-1]:.2f} s, "
                  f"g = {g:g} m/s², status {resp.status}, energy balance error "
                  f"{summary['energy_balance_error']:.1e}")

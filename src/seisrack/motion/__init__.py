@@ -9,10 +9,19 @@ Public API (SI units: m/s², s):
 - :class:`Spectrum`, :func:`response_spectrum` — exact response spectra (``spectra``);
 - :func:`generate_ec8_record`, :func:`generate_ec8_suite` — spectrum-compatible accelerograms
   (``synth``);
-- :func:`check_ec8_suite` — EN 1998-1 §3.2.3.1.2 suite report (``check``).
+- :func:`check_ec8_suite`, :func:`read_suite`, :func:`suite_scale_factor` — EN 1998-1
+  §3.2.3.1.2 suite report for files or folders, and the common scale factor (``check``);
+- :func:`scale_by`, :func:`scale_to_pga`, :func:`scale_to_sa`, :func:`scale_record` — record
+  scaling (``scaling``).
 """
 
-from seisrack.motion.check import CheckItem, SuiteReport, check_ec8_suite
+from seisrack.motion.check import (
+    CheckItem,
+    SuiteReport,
+    check_ec8_suite,
+    read_suite,
+    suite_scale_factor,
+)
 from seisrack.motion.ec8 import DesignSpectrum, EC8Spectrum, damping_correction, ec8_spectrum
 from seisrack.motion.records import (
     G,
@@ -22,6 +31,7 @@ from seisrack.motion.records import (
     read_record,
     write_record_csv,
 )
+from seisrack.motion.scaling import scale_by, scale_record, scale_to_pga, scale_to_sa
 from seisrack.motion.spectra import Spectrum, response_spectrum
 from seisrack.motion.synth import envelope, generate_ec8_record, generate_ec8_suite
 
@@ -42,6 +52,12 @@ __all__ = [
     "list_builtin_records",
     "load_builtin_record",
     "read_record",
+    "read_suite",
     "response_spectrum",
+    "scale_by",
+    "scale_record",
+    "scale_to_pga",
+    "scale_to_sa",
+    "suite_scale_factor",
     "write_record_csv",
 ]

@@ -12,19 +12,26 @@ Checks, each reported pass/fail with its numbers:
   as the time between the first and last instants where the 2 s moving RMS acceleration reaches
   half its maximum (-6 dB). EC8 gives no measure; this estimate is ours and is approximate
   (it counts part of the ramps of a trapezoidal envelope).
+
+Scaling a suite. Both amplitude rules are linear in a common factor f applied to every record
+(spectra and PGAs scale with f), so the smallest factor meeting both is
+``f = max(0.9 / min(mean/target), a_g·S / mean PGA)`` (:func:`suite_scale_factor`). It is
+reported with every check (``SuiteReport.scale_factor``); f < 1 means the suite complies with a
+margin and could be scaled down by that much.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from seisrack.errors import InputError
 from seisrack.motion.ec8 import DesignSpectrum
-from seisrack.motion.records import Record
+from seisrack.motion.records import _HEADER, Record, read_record
 from seisrack.motion.spectra import response_spectrum
 
 
@@ -51,6 +58,8 @@ class SuiteReport:
     mean_psa: np.ndarray
     target_psa: np.ndarray
     records: list[dict[str, Any]] = field(default_factory=list)
+    #: smallest common factor making the suite meet §3.2.3.1.2(4)a and (4)b (see module notes)
+    scale_factor: float = float("nan")
 
     @property
     def passed(self) -> bool:
@@ -62,6 +71,7 @@ class SuiteReport:
             "passed": self.passed,
             "checks": [vars(i) for i in self.items],
             "records": self.records,
+            "scale_factor_needed": self.scale_factor,
             "periods_s": self.periods,
             "mean_psa_m_s2": self.mean_psa,
             "target_psa_m_s2": self.target_psa,
@@ -74,7 +84,50 @@ class SuiteReport:
             flag = "PASS" if i.passed else "FAIL"
             lines.append(f"[{flag}] {i.name}: {i.value:.4g} (required {i.required:.4g}) {i.note}")
         lines.append("suite " + ("complies" if self.passed else "does NOT comply"))
+        if np.isfinite(self.scale_factor):
+            lines.append(f"smallest common scale factor meeting the PGA and spectrum rules: "
+                         f"{self.scale_factor:.4g}")
         return "\n".join(lines)
+
+
+#: file endings :func:`read_suite` picks up in a folder (case-insensitive)
+SUITE_SUFFIXES = (".at2", ".csv", ".txt")
+
+
+def read_suite(
+    paths: Sequence[str | Path], units: str | None = None, dt: float | None = None
+) -> list[Record]:
+    """Read a suite of records from files and/or folders, with :func:`read_record`.
+
+    A folder contributes its files ending in ``.AT2``, ``.csv`` or ``.txt`` (any case), sorted
+    by name. ``units`` and ``dt`` apply to the files that need them: PEER ``.AT2`` files are
+    always in g and seisrack CSV files declare m/s² in their header, so one suite may mix them
+    with ``units`` given for the others.
+    """
+    files: list[Path] = []
+    for entry in paths:
+        p = Path(entry)
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir()
+                           if f.is_file() and f.suffix.lower() in SUITE_SUFFIXES)
+            if not found:
+                raise InputError("files", str(p), "a folder holding record files ("
+                                 + ", ".join(SUITE_SUFFIXES) + ")")
+            files.extend(found)
+        elif p.is_file():
+            files.append(p)
+        else:
+            raise InputError("files", str(p), "an existing record file or folder")
+    return [read_record(f, units=None if _declares_units(f) else units, dt=dt) for f in files]
+
+
+def _declares_units(path: Path) -> bool:
+    """True for a ``.AT2`` file (g) or a seisrack CSV whose header gives m/s²."""
+    if path.suffix.lower() == ".at2":
+        return True
+    with path.open(encoding="utf-8", errors="replace") as fh:
+        first = fh.readline()
+    return first.strip().replace(" ", "").lower() == _HEADER
 
 
 def stationary_duration(record: Record) -> float:
@@ -137,4 +190,26 @@ def check_ec8_suite(
         {"name": r.name, "pga_m_s2": p, "stationary_s": s, "duration_s": r.duration}
         for r, p, s in zip(records, pgas, stats, strict=True)
     ]
-    return SuiteReport(items, T, mean, tgt, recs)
+    factor = suite_scale_factor(mean, tgt, pgas, target.pga)
+    return SuiteReport(items, T, mean, tgt, recs, factor)
+
+
+def suite_scale_factor(
+    mean_psa: np.ndarray, target_psa: np.ndarray, pgas: np.ndarray, target_pga: float,
+    *, spectrum_fraction: float = 0.9,
+) -> float:
+    """Smallest common factor f with f·mean ≥ 0.9·target on the range and f·mean PGA ≥ a_g·S.
+
+    Args:
+        mean_psa, target_psa: (n,) [m/s²] mean spectrum of the suite and target, same periods.
+        pgas: (n_rec,) [m/s²] records' PGAs. target_pga: [m/s²] a_g·S.
+
+    Both rules are linear in f (EN 1998-1 §3.2.3.1.2(4)a, (4)b). Returns inf when the suite's
+    mean spectrum or PGA is zero somewhere (no factor can help).
+    """
+    mean_psa = np.asarray(mean_psa, dtype=float)
+    mean_pga = float(np.mean(pgas))
+    if np.any(mean_psa <= 0) or not mean_pga > 0:
+        return float("inf")
+    f_spec = float(np.max(spectrum_fraction * np.asarray(target_psa) / mean_psa))
+    return max(f_spec, float(target_pga) / mean_pga)
