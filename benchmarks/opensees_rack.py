@@ -52,6 +52,14 @@ Mapping from the compiled :class:`seisrack.model.FrameModel` (``model.mesh``):
   record's dt (linear interpolation, as seisrack's analysis grid);
 - Newmark average acceleration (gamma = 1/2, beta = 1/4), Newton, NormDispIncr test.
 
+Two builders make this same model: :func:`build_from_export` executes the script written by
+``seisrack export opensees`` (``seisrack.export.opensees_script``), so the benchmark and the
+parity test check what users get, and :func:`run` and ``scale_opensees.py`` use it.
+:func:`build` is the original hand-built model, kept for two things the export does not
+write: the ``element="elastic"`` (elasticBeamColumn) demonstration of the OpenSees 3.7.1 bug,
+and one friction coefficient per pallet given as an array. Both give the same tags and
+commands (checked: identical histories, see ``tests/test_export_opensees.py``).
+
 A step whose ``analyze`` fails is retried with 10 and 100 substeps, then with ModifiedNewton
 (initial tangent) and KrylovNewton; if it still fails it is forced through with a fixed number
 of iterations and counted in ``failed_steps``. Steps that needed any fallback are counted in
@@ -294,6 +302,46 @@ def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
     )
 
 
+def exported_namespace(model, mu: float | None = None, k_init: float = 1e8,
+                       pallets: str = "friction") -> dict[str, Any]:
+    """Execute the script of ``seisrack export opensees`` for ``model`` (it defines its tables
+    and ``build``/``modal``/``run`` but builds nothing) and return its namespace."""
+    from seisrack.export import opensees_script
+
+    text = opensees_script(model, pallets=pallets, mu=mu, k_init=k_init)
+    ns: dict[str, Any] = {"__name__": "seisrack_exported_rack"}
+    exec(compile(text, "<seisrack export opensees>", "exec"), ns)  # noqa: S102 - our own text
+    return ns
+
+
+def build_from_export(model, mu: float | None = None, k_init: float = 1e8,
+                      pallets: str = "friction") -> OpenSeesRack:
+    """Wipe the OpenSees domain and build ``model`` with its exported script.
+
+    The same model as :func:`build` with ``element="disp"`` (same tags, same commands; the
+    exported script is what users get from ``seisrack export opensees``), so the benchmark and
+    the parity test check the export. mu: one coefficient for every pallet or None (each
+    pallet's ``mu_static``).
+    """
+    if pallets not in PALLET_MODES:
+        raise ValueError(f"pallets must be one of {PALLET_MODES}, not {pallets!r}")
+    ns = exported_namespace(model, mu=mu, k_init=k_init, pallets=pallets)
+    ns["build"](pallets)
+    n_node = len(ns["NODES"])
+    rigid = pallets == "rigid"
+    return OpenSeesRack(
+        node_tag=np.arange(1, n_node + 1),
+        level_nodes=[np.array(lv, dtype=int) for lv in ns["LEVEL_NODES"]],
+        pallet_beam_node=np.array(ns["PALLET_BEAM_NODE"], dtype=int),
+        pallet_node=np.array(ns["PALLET_NODE"], dtype=int),
+        pallet_element=np.array([-1] * len(ns["PALLETS"]) if rigid else ns["PALLET_ELEMENT"],
+                                dtype=int),
+        pallet_level=np.array(ns["PALLET_LEVEL"], dtype=int),
+        structure_elements=list(range(1, ns["N_STRUCTURE_ELEMENTS"] + 1)),
+        n_eq=len(ns["EQUAL_DOF"]) + (len(ns["PALLETS"]) if rigid else 0),
+    )
+
+
 def periods(n_modes: int = 3) -> np.ndarray:
     """Periods [s] of the model currently built (pallets held by their elastic springs)."""
     ops = _ops()
@@ -374,7 +422,11 @@ def run(
     """
     ops = _ops()
     t0 = time.perf_counter()
-    rack = build(model, mu=mu, k_init=k_init, element=element, pallets=pallets)
+    if element == "disp" and np.ndim(mu) == 0:
+        rack = build_from_export(model, mu=None if mu is None else float(mu), k_init=k_init,
+                                 pallets=pallets)
+    else:  # the elasticBeamColumn demonstration, or one mu per pallet: the hand-built model
+        rack = build(model, mu=mu, k_init=k_init, element=element, pallets=pallets)
     ag = np.asarray(record.accel, dtype=float)
     setup_analysis(ag, float(record.dt), tol=tol, max_iter=max_iter)
     build_time = time.perf_counter() - t0
@@ -432,6 +484,8 @@ def run(
             "element": ("dispBeamColumn, Elastic section, Legendre 3, -cMass"
                         if element == "disp" else "elasticBeamColumn -cMass"),
             "friction": "zeroLength ElasticPP" if pallets == "friction" else "rigid (equalDOF)",
+            "model": ("seisrack export opensees script"
+                      if element == "disp" and np.ndim(mu) == 0 else "hand-built (build())"),
             "rayleigh": list(model.damping_coefficients),
         },
     )

@@ -1,7 +1,8 @@
 """The OpenSeesPy peer of the scale benchmark: one function, :func:`run_opensees`.
 
 ``benchmarks/scale.py`` calls it with the same compiled rack, ground motion and step as
-seisrack. The model is ``benchmarks/opensees_rack.py`` (node for node from ``model.mesh``):
+seisrack. The model is the script of ``seisrack export opensees`` for that rack, executed by
+``benchmarks/opensees_rack.py`` (``build_from_export``; node for node from ``model.mesh``):
 
 - ``mu=None``: pallets rigidly attached (``equalDOF`` in ux, the model is linear), solved with
   ``Linear -factorOnce`` — the cheapest correct OpenSees setting for a linear model at a
@@ -92,8 +93,8 @@ def run_opensees(
         return out
     rigid = mu is None
     t0 = time.perf_counter()
-    rack = osr.build(model, mu=None if rigid else float(mu), k_init=k_init,
-                     pallets="rigid" if rigid else "friction")
+    rack = osr.build_from_export(model, mu=None if rigid else float(mu), k_init=k_init,
+                                 pallets="rigid" if rigid else "friction")
     osr.setup_analysis(ag, dt, system=system, tol=tol, max_iter=max_iter, linear=rigid)
     build_time = time.perf_counter() - t0
 
@@ -134,6 +135,7 @@ def run_opensees(
             "integrator": "Newmark 0.5 0.25", "constraints": "Transformation",
             "numberer": "RCM", "element": "dispBeamColumn, Elastic section, Legendre 3, -cMass",
             "rayleigh": list(model.damping_coefficients),
+            "model": "seisrack export opensees script",
         },
     )
     return out

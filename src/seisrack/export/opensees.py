@@ -73,7 +73,7 @@ def opensees_script(
     t = _tables(model, mu)
     dense = model.n_dof <= DENSE_MAX_DOF
     mu_d_differs = bool(mu is None and np.any(model.pallet_mu_dynamic != model.pallet_mu_static))
-    if mu_d_differs:
+    if mu_d_differs and pallets == "friction":
         log.warning("the OpenSees friction elements use mu_static; the rack's lower dynamic "
                     "coefficients are not represented")
     parts = [
