@@ -1,0 +1,277 @@
+"""Executors: run batches of study runs on a local process pool or a Dask cluster.
+
+The worker side is :func:`run_batch`: it runs each :class:`~seisrack.studies.expand.Run` of a
+batch and returns one row (a dict, the store's schema) per run. A worker limits BLAS to one
+thread (with the default threaded OpenBLAS, the engine's small dense algebra costs 10–150× more
+CPU on a loaded machine), and caches compiled models and scaled records per process. A run that
+fails (a :class:`~seisrack.errors.SeisrackError`, a solver status other than "ok", or any other
+exception) is a row with ``status = "failed"`` and the reason; it never stops the batch.
+
+The executors are strategies with one method, ``run(batches)``, an iterator over the rows of
+each finished batch, in completion order:
+
+- :class:`LocalExecutor`: ``concurrent.futures.ProcessPoolExecutor``; a worker killed by a
+  signal breaks the pool: the pool is rebuilt and the unfinished batches resubmitted (split
+  into single runs on the second failure; a run that kills its worker three times is recorded
+  as failed);
+- :class:`DaskExecutor`: a ``dask.distributed.Client`` on a scheduler address, or on a
+  ``LocalCluster(n_workers, threads_per_worker=1)``; the context (racks, records) is scattered
+  once to every worker.
+
+Results do not depend on the executor: every run is computed from its own inputs only, by the
+same code, with one BLAS thread.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import time
+from collections import deque
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from seisrack.errors import SeisrackError
+
+log = logging.getLogger(__name__)
+
+#: test hook (JSON): {"kill_once": [run_id, flag_file], "fail": [run_id, ...], "sleep": s}
+TEST_HOOK_ENV = "SEISRACK_STUDY_TEST_HOOK"
+
+_CTX: Any = None  # the StudyPlan (without its runs) of the current process
+_CTX_ID: str | None = None
+_MODELS: dict = {}
+_RECORDS: dict = {}
+_LIMITER: Any = None
+_CACHE_MAX = 128
+
+
+def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
+    global _CTX, _CTX_ID, _LIMITER
+    if ctx_id is not None and ctx_id == _CTX_ID:
+        return
+    _CTX, _CTX_ID = ctx, ctx_id
+    _MODELS.clear()
+    _RECORDS.clear()
+    if _LIMITER is None:
+        from threadpoolctl import threadpool_limits
+
+        _LIMITER = threadpool_limits(1)  # kept for the life of the worker process
+
+
+def run_batch(batch: list) -> list[dict[str, Any]]:
+    """Rows of the runs of ``batch`` (worker side; the context was set by the initializer)."""
+    return [run_one(r) for r in batch]
+
+
+def run_batch_ctx(ctx: Any, ctx_id: str, batch: list) -> list[dict[str, Any]]:
+    """:func:`run_batch` with its context passed in (Dask: a scattered future)."""
+    _set_context(ctx, ctx_id)
+    return run_batch(batch)
+
+
+def _hook(run) -> None:  # noqa: ANN001
+    text = os.environ.get(TEST_HOOK_ENV)
+    if not text:
+        return
+    hook = json.loads(text)
+    if hook.get("sleep"):
+        time.sleep(float(hook["sleep"]))
+    kill = hook.get("kill_once")
+    if kill and kill[0] == run.run_id and not os.path.exists(kill[1]):
+        with open(kill[1], "w") as fh:
+            fh.write(str(os.getpid()))
+        import signal
+
+        os.kill(os.getpid(), signal.SIGKILL)
+    if run.run_id in hook.get("fail", ()):
+        raise SeisrackError(f"test hook: run {run.run_id} made to fail")
+
+
+def _model(run):  # noqa: ANN001, ANN202
+    key = (run.rack_hash, run.occupancy, run.mu_static, run.mu_dynamic)
+    m = _MODELS.get(key)
+    if m is None:
+        from seisrack.model import compile_rack
+        from seisrack.model.spec import with_friction
+        from seisrack.studies.expand import apply_pattern
+
+        rack = apply_pattern(_CTX.racks[run.rack_hash], _CTX.patterns[(run.rack_hash,
+                                                                        run.occupancy)])
+        m = compile_rack(with_friction(rack, run.mu_static, run.mu_dynamic))
+        if len(_MODELS) >= _CACHE_MAX:
+            _MODELS.clear()
+        _MODELS[key] = (m, rack)
+        return m, rack
+    return m
+
+
+def _scaled(run):  # noqa: ANN001, ANN202
+    key = (run.record_hash, run.scale_factor)
+    rec = _RECORDS.get(key)
+    if rec is None:
+        from seisrack.motion import Record
+
+        base = _CTX.records[run.record_hash]
+        rec = Record(base.accel * run.scale_factor, base.dt, name=base.name,
+                     provenance=f"{base.provenance}, scaled by {run.scale_factor:.6g}")
+        if len(_RECORDS) >= _CACHE_MAX:
+            _RECORDS.clear()
+        _RECORDS[key] = rec
+    return rec
+
+
+def _inputs(run) -> dict[str, Any]:  # noqa: ANN001
+    return {"run_id": run.run_id, "rack": run.rack, "record": run.record,
+            "im_measure": run.im_measure, "im_target": run.im_target,
+            "scale_factor": run.scale_factor, "stripe": run.stripe, "mu_static": run.mu_static,
+            "mu_dynamic": run.mu_dynamic, "occupancy": run.occupancy, "seed": run.seed}
+
+
+def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # noqa: ANN001
+    nan = math.nan
+    return {**_inputs(run), "status": "failed", "error": reason, "peak_sliding_max_m": nan,
+            "pallet_peak_sliding_m": [], "n_pallets": 0, "any_fall": False, "n_fall": 0,
+            "base_shear_N": nan, "beam_displacement_max_m": nan, "drift_ratio_max": nan,
+            "upright_moment_connection_Nm": nan, "wall_time_s": wall}
+
+
+def run_one(run) -> dict[str, Any]:  # noqa: ANN001
+    """Scale the record, compile the rack with the run's friction, run it, extract the row."""
+    from seisrack.analysis import run_rack
+
+    t0 = time.perf_counter()
+    try:
+        _hook(run)
+        model, rack = _model(run)
+        res = run_rack(model, _scaled(run), dt=_CTX.dt, save_every=None, track_energy=False,
+                       throw=False)
+        if res.status != "ok":
+            return failed_row(run, f"solver status: {res.status}", time.perf_counter() - t0)
+        fp = res.full_peaks
+        sliding = res.pallet_peak_sliding()
+        disp = np.asarray(fp["beam_displacement"], dtype=float)
+        # drift: an envelope from the per-level peaks (exact for one level; above, peaks of
+        # adjacent levels need not be simultaneous)
+        heights = np.asarray(rack.geometry.levels, dtype=float)
+        drift = np.abs(np.diff(np.concatenate([[0.0], disp]))) / heights
+        at_risk = res.pallets_at_risk()
+        return {**_inputs(run), "status": "ok", "error": "",
+                "peak_sliding_max_m": float(sliding.max()) if sliding.size else 0.0,
+                "pallet_peak_sliding_m": [float(s) for s in sliding],
+                "n_pallets": int(res.n_pallets), "any_fall": bool(at_risk),
+                "n_fall": len(at_risk), "base_shear_N": float(fp["base_shear"]),
+                "beam_displacement_max_m": float(disp.max()),
+                "drift_ratio_max": float(drift.max()),
+                "upright_moment_connection_Nm": float(fp["upright_moment_connection"]),
+                "wall_time_s": time.perf_counter() - t0}
+    except Exception as exc:  # noqa: BLE001 - a failed run is a row, never a stopped study
+        kind = "" if isinstance(exc, SeisrackError) else f"{type(exc).__name__}: "
+        return failed_row(run, f"{kind}{exc}", time.perf_counter() - t0)
+
+
+def _context_of(plan) -> Any:  # noqa: ANN001
+    from dataclasses import replace
+
+    return replace(plan, runs=())
+
+
+class LocalExecutor:
+    """A ``ProcessPoolExecutor`` with ``workers`` processes (default: one per core)."""
+
+    name = "local"
+
+    def __init__(self, plan, workers: int | None = None) -> None:  # noqa: ANN001
+        self.ctx = _context_of(plan)
+        self.workers = workers or os.cpu_count() or 1
+
+    def run(self, batches: list[list]) -> Iterator[list[dict[str, Any]]]:
+        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+        from concurrent.futures.process import BrokenProcessPool
+
+        pending = deque((b, 0) for b in batches)
+        while pending:
+            pool = ProcessPoolExecutor(self.workers, initializer=_set_context,
+                                       initargs=(self.ctx,))
+            inflight: dict = {}
+            broken: list = []
+            try:
+                while (pending or inflight) and not broken:
+                    while pending and len(inflight) < 2 * self.workers:
+                        b, a = pending.popleft()
+                        inflight[pool.submit(run_batch, b)] = (b, a)
+                    done, _ = wait(inflight, return_when=FIRST_COMPLETED)
+                    for f in done:
+                        b, a = inflight.pop(f)
+                        try:
+                            rows = f.result()
+                        except BrokenProcessPool:
+                            broken.append((b, a))
+                            continue
+                        yield rows
+            finally:
+                pool.shutdown(wait=True, cancel_futures=True)
+            if broken:
+                broken.extend(inflight.values())
+                log.warning("a worker process died: resubmitting %d batch(es)", len(broken))
+                yield from self._requeue(broken, pending)
+
+    @staticmethod
+    def _requeue(broken: list, pending: deque) -> Iterator[list[dict[str, Any]]]:
+        for b, a in broken:
+            if a == 0:
+                pending.append((b, 1))
+            elif len(b) > 1:
+                pending.extend(([r], 2) for r in b)
+            elif a < 3:
+                pending.append((b, a + 1))
+            else:
+                yield [failed_row(b[0], "the worker process died (killed by a signal?) "
+                                        "three times on this run")]
+
+
+class DaskExecutor:
+    """Batches on a Dask cluster: ``scheduler`` address, or a new ``LocalCluster``."""
+
+    name = "dask"
+
+    def __init__(self, plan, workers: int | None = None,  # noqa: ANN001
+                 scheduler: str | None = None) -> None:
+        self.ctx = _context_of(plan)
+        self.workers = workers or os.cpu_count() or 1
+        self.scheduler = scheduler
+
+    def run(self, batches: list[list]) -> Iterator[list[dict[str, Any]]]:
+        import uuid
+
+        from dask.distributed import Client, LocalCluster, as_completed
+
+        cluster = None
+        if self.scheduler:
+            client = Client(self.scheduler)
+        else:
+            cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        try:
+            ctx = client.scatter(self.ctx, broadcast=True)
+            ctx_id = uuid.uuid4().hex
+            futures = {client.submit(run_batch_ctx, ctx, ctx_id, b, pure=False): b
+                       for b in batches}
+            for f in as_completed(futures):
+                b = futures.pop(f)
+                try:
+                    rows = f.result()
+                except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker: runs fail
+                    rows = [failed_row(r, f"dask task failed: {type(exc).__name__}: {exc}")
+                            for r in b]
+                f.release()
+                yield rows
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()

@@ -1,0 +1,307 @@
+"""The study specification: what a user writes in a study TOML, validated once at the boundary.
+
+Every key is documented in ``docs/user/study_toml.md``. :func:`load_study` reads the file and
+returns a frozen :class:`StudySpec`; every mistake a user can make in the file is an
+:class:`~seisrack.errors.InputError` naming the field path (``friction.dispersion``), the value
+and what is allowed. Problems that need the records or the rack (a missing file, an intensity
+that cannot be reached by scaling) are found by :func:`seisrack.studies.expand.expand`, still
+before any run starts.
+
+Units: SI inside (m/s² for PGA and Sa); ``intensity.unit = "g"`` converts the stripes once here.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from seisrack.errors import FileFormatError, InputError
+from seisrack.model._reader import Table, check_number
+from seisrack.motion.records import G
+
+MEASURES = ("pga", "sa")
+DISTRIBUTIONS = ("lognormal", "uniform", "truncnormal")
+DEFAULT_DT = 0.005  # s, analysis step
+DEFAULT_MAX_SCALE = 50.0  # largest scale factor accepted on a record
+_TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed")
+
+
+@dataclass(frozen=True)
+class EC8Suite:
+    """A generated suite of EN 1998-1 spectrum-compatible records (``[[records.ec8]]``)."""
+
+    type: int = 1
+    ground: str = "C"
+    ag: float = 0.3  # [g] design ground acceleration of the target spectrum
+    duration: float = 10.0  # [s]
+    count: int = 7
+    seed: int = 0
+    dt: float = 0.01  # [s] record time step
+
+
+@dataclass(frozen=True)
+class RecordsSpec:
+    """Where the records come from: a folder of files, bundled records, generated suites."""
+
+    folder: str | None = None  # resolved path of the folder (AT2 / CSV / TXT files)
+    folder_as_given: str | None = None
+    units: str | None = None  # units of CSV/TXT files without a header ("g" or "m/s2")
+    file_dt: float | None = None  # [s] time step of one-column files
+    builtin: tuple[str, ...] = ()
+    ec8: tuple[EC8Suite, ...] = ()
+
+
+@dataclass(frozen=True)
+class IntensitySpec:
+    """The intensity measure and the levels the records are scaled to.
+
+    stripes: (n,) [m/s²] targets (multiple-stripe analysis), or ``ida`` (incremental dynamic
+    analysis on a fixed grid ``start, start + step, …`` up to ``stop``).
+    """
+
+    measure: str = "pga"  # "pga" or "sa" (Sa(T1, damping) of the rack's first mode)
+    stripes: tuple[float, ...] = ()
+    ida: tuple[float, ...] = ()  # [m/s²] the IDA grid, expanded
+    damping: float = 0.05
+    max_scale: float = DEFAULT_MAX_SCALE
+
+    @property
+    def levels(self) -> tuple[float, ...]:
+        return self.stripes or self.ida
+
+    @property
+    def is_ida(self) -> bool:
+        return not self.stripes
+
+
+@dataclass(frozen=True)
+class FrictionSpec:
+    """Friction of every pallet: a list of values, or a distribution sampled per run.
+
+    kind: "values", "lognormal" (median, dispersion = σ of ln μ), "uniform" (low, high) or
+    "truncnormal" (mean, std, low, high). ``samples``: draws per (rack, record, occupancy)
+    for a distribution; ``dynamic_ratio`` = μ_dynamic / μ_static.
+    """
+
+    kind: str = "values"
+    values: tuple[float, ...] = (0.4,)
+    params: tuple[tuple[str, float], ...] = ()
+    samples: int = 1
+    dynamic_ratio: float = 1.0
+
+    def param(self, name: str) -> float:
+        return dict(self.params)[name]
+
+
+@dataclass(frozen=True)
+class StudySpec:
+    """A validated study. ``racks`` are resolved paths; ``racks_as_given`` as in the file."""
+
+    racks: tuple[str, ...]
+    racks_as_given: tuple[str, ...]
+    records: RecordsSpec
+    intensity: IntensitySpec
+    friction: FrictionSpec = FrictionSpec()
+    occupancy: tuple[float, ...] = (1.0,)
+    dt: float = DEFAULT_DT
+    seed: int = 0
+    title: str = ""
+    source: str | None = None
+    text: str = ""  # the study file as given (stored in study.json)
+
+
+def load_study(path: str | Path) -> StudySpec:
+    """Read and validate a study TOML file (paths inside are relative to the file)."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("study", str(p), "an existing study TOML file")
+    raw = p.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+        data = tomllib.loads(text)
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise FileFormatError(str(p), f"malformed TOML: {exc}") from None
+    return study_from_dict(data, base=p.parent, source=str(p), text=text)
+
+
+def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None,
+                    text: str = "") -> StudySpec:
+    """Validate a parsed study document; relative paths are taken from ``base``."""
+    base = Path(base)
+    root = Table(d, "", source)
+    title = root.string("title", "")
+    racks_raw = root.raw("racks")
+    racks_list = [racks_raw] if isinstance(racks_raw, str) else racks_raw
+    if not isinstance(racks_list, list) or not racks_list or not all(
+            isinstance(r, str) and r for r in racks_list):
+        raise root.error("racks", racks_raw, "a rack TOML path or a non-empty array of paths "
+                                             "(relative to the study file)")
+    if len(set(racks_list)) != len(racks_list):
+        raise root.error("racks", racks_raw, "distinct paths (a rack is listed twice)")
+    racks = []
+    for i, r in enumerate(racks_list):
+        rp = (base / r) if not Path(r).is_absolute() else Path(r)
+        if not rp.is_file():
+            field = "racks" if isinstance(racks_raw, str) else f"racks[{i}]"
+            raise InputError(field, r, f"an existing rack TOML file (looked for {rp})",
+                             source=source)
+        racks.append(str(rp))
+    records = _records(root.table("records"), base)
+    intensity = _intensity(root.table("intensity"))
+    friction = _friction(root.table("friction", {"values": [0.4]}))
+    occupancy = _occupancy(root.table("occupancy", {}))
+    dt = root.number("dt", DEFAULT_DT, positive=True, unit="s")
+    seed = root.integer("seed", 0, minimum=0)
+    root.finish(_TOP_KEYS)
+    return StudySpec(racks=tuple(racks), racks_as_given=tuple(racks_list), records=records,
+                     intensity=intensity, friction=friction, occupancy=occupancy, dt=dt,
+                     seed=seed, title=title, source=source, text=text)
+
+
+def _records(t: Table, base: Path) -> RecordsSpec:
+    folder = folder_given = None
+    if t.has("folder"):
+        folder_given = t.string("folder")
+        fp = base / folder_given
+        if not fp.is_dir():
+            raise t.error("folder", folder_given, f"an existing folder of records (looked for {fp})")
+        folder = str(fp)
+    units = t.string("units", None) if t.has("units") else None
+    if units is not None and units not in ("g", "m/s2"):
+        raise t.error("units", units, "'g' or 'm/s2'")
+    file_dt = t.number("dt", positive=True, unit="s") if t.has("dt") else None
+    builtin_raw = t.raw("builtin", [])
+    builtin = [builtin_raw] if isinstance(builtin_raw, str) else builtin_raw
+    from seisrack.motion import list_builtin_records
+
+    known = list_builtin_records()
+    if not isinstance(builtin, list):
+        raise t.error("builtin", builtin_raw, "a bundled record name or an array of names")
+    for i, name in enumerate(builtin):
+        if name not in known:
+            raise t.error(f"builtin[{i}]", name, "one of " + ", ".join(known))
+    ec8_raw = t.raw("ec8", [])
+    ec8_list = [ec8_raw] if isinstance(ec8_raw, dict) else ec8_raw
+    if not isinstance(ec8_list, list):
+        raise t.error("ec8", ec8_raw, "a table or an array of tables [[records.ec8]]")
+    ec8 = tuple(_ec8(Table(e, f"{t.field('ec8')}[{i}]", t.source)) for i, e in enumerate(ec8_list))
+    t.finish(("folder", "units", "dt", "builtin", "ec8"))
+    if folder is None and not builtin and not ec8:
+        raise t.error("<records>", {}, "at least one of folder, builtin, ec8")
+    return RecordsSpec(folder=folder, folder_as_given=folder_given, units=units, file_dt=file_dt,
+                       builtin=tuple(builtin), ec8=ec8)
+
+
+def _ec8(t: Table) -> EC8Suite:
+    typ = t.integer("type", 1, minimum=1)
+    if typ not in (1, 2):
+        raise t.error("type", typ, "1 or 2 (EN 1998-1 spectrum type)")
+    ground = t.string("ground", "C")
+    if ground not in ("A", "B", "C", "D", "E"):
+        raise t.error("ground", ground, "one of A, B, C, D, E")
+    s = EC8Suite(type=typ, ground=ground, ag=t.number("ag", 0.3, positive=True, unit="g"),
+                 duration=t.number("duration", 10.0, positive=True, unit="s"),
+                 count=t.integer("count", 7, minimum=1), seed=t.integer("seed", 0, minimum=0),
+                 dt=t.number("dt", 0.01, positive=True, unit="s"))
+    t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt"))
+    return s
+
+
+def _intensity(t: Table) -> IntensitySpec:
+    measure = t.string("measure", "pga")
+    if measure not in MEASURES:
+        raise t.error("measure", measure, "'pga' (peak ground acceleration) or 'sa' "
+                                          "(Sa(T1) of the rack's first mode)")
+    unit = t.string("unit", "m/s2")
+    if unit not in ("m/s2", "g"):
+        raise t.error("unit", unit, "'m/s2' (default) or 'g'")
+    factor = G if unit == "g" else 1.0
+    damping = t.number("damping", 0.05, nonnegative=True)
+    if damping >= 1.0:
+        raise t.error("damping", damping, "a damping ratio in [0, 1)")
+    max_scale = t.number("max_scale", DEFAULT_MAX_SCALE, positive=True)
+    if t.has("stripes") == t.has("ida"):
+        raise t.error("stripes", t.data.get("stripes"),
+                      "exactly one of 'stripes' (an array of levels) or 'ida' (a table "
+                      "{start, step, stop})")
+    stripes: tuple[float, ...] = ()
+    ida: tuple[float, ...] = ()
+    if t.has("stripes"):
+        raw = t.array("stripes")
+        if not raw:
+            raise t.error("stripes", raw, f"a non-empty array of intensity levels > 0 [{unit}]")
+        stripes = tuple(factor * check_number(v, f"{t.field('stripes')}[{i}]", positive=True,
+                                              unit=unit, source=t.source)
+                        for i, v in enumerate(raw))
+        if len(set(stripes)) != len(stripes):
+            raise t.error("stripes", raw, "distinct levels (a level is listed twice)")
+    else:
+        it = t.table("ida")
+        start = it.number("start", positive=True, unit=unit)
+        step = it.number("step", positive=True, unit=unit)
+        stop = it.number("stop", positive=True, unit=unit)
+        it.finish(("start", "step", "stop"))
+        if stop < start:
+            raise it.error("stop", stop, f"a level >= start ({start:g} {unit})")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        if n > 1000:
+            raise it.error("step", step, "a step giving at most 1000 IDA levels")
+        ida = tuple(factor * (start + k * step) for k in range(n))
+    t.finish(("measure", "unit", "stripes", "ida", "damping", "max_scale"))
+    return IntensitySpec(measure=measure, stripes=stripes, ida=ida, damping=damping,
+                         max_scale=max_scale)
+
+
+def _friction(t: Table) -> FrictionSpec:
+    ratio = t.number("dynamic_ratio", 1.0, positive=True)
+    if ratio > 1.0:
+        raise t.error("dynamic_ratio", ratio, "a ratio mu_dynamic / mu_static in (0, 1]")
+    if t.has("values") == t.has("dist"):
+        raise t.error("values", t.data.get("values"),
+                      "exactly one of 'values' (an array of mu_static) or 'dist' "
+                      f"({', '.join(DISTRIBUTIONS)})")
+    if t.has("values"):
+        raw = t.array("values", min_len=1)
+        vals = tuple(check_number(v, f"{t.field('values')}[{i}]", positive=True,
+                                  source=t.source) for i, v in enumerate(raw))
+        t.finish(("values", "dynamic_ratio"))
+        return FrictionSpec(kind="values", values=vals, dynamic_ratio=ratio)
+    dist = t.string("dist")
+    samples = t.integer("samples", 1, minimum=1)
+    if dist == "lognormal":
+        params = {"median": t.number("median", positive=True),
+                  "dispersion": t.number("dispersion", positive=True)}
+        keys = ("median", "dispersion")
+    elif dist == "uniform":
+        params = {"low": t.number("low", positive=True), "high": t.number("high", positive=True)}
+        if params["high"] <= params["low"]:
+            raise t.error("high", params["high"], f"a value > low ({params['low']:g})")
+        keys = ("low", "high")
+    elif dist == "truncnormal":
+        params = {"mean": t.number("mean", positive=True), "std": t.number("std", positive=True),
+                  "low": t.number("low", positive=True), "high": t.number("high", positive=True)}
+        if params["high"] <= params["low"]:
+            raise t.error("high", params["high"], f"a value > low ({params['low']:g})")
+        keys = ("mean", "std", "low", "high")
+    else:
+        raise t.error("dist", dist, ", ".join(DISTRIBUTIONS))
+    t.finish(("dist", "samples", "dynamic_ratio") + keys)
+    return FrictionSpec(kind=dist, values=(), params=tuple(params.items()), samples=samples,
+                        dynamic_ratio=ratio)
+
+
+def _occupancy(t: Table) -> tuple[float, ...]:
+    raw = t.array("fractions", [1.0], min_len=1)
+    out = tuple(check_number(v, f"{t.field('fractions')}[{i}]", positive=True, source=t.source)
+                for i, v in enumerate(raw))
+    for i, v in enumerate(out):
+        if v > 1.0:
+            raise InputError(f"{t.field('fractions')}[{i}]", v, "a fraction in (0, 1]",
+                             source=t.source)
+    t.finish(("fractions",))
+    return out

@@ -1,0 +1,135 @@
+"""The study store: ``study.json`` and one Parquet part file per flushed batch of rows.
+
+Layout of ``out_dir``::
+
+    study.json                 the study as given and the expanded run table (ids and inputs)
+    runs/part-<hash>.parquet   rows of finished runs (schema :data:`SCHEMA`), one file per flush
+
+Why Parquet (through pyarrow): it is columnar (a fragility fit reads two columns of 10⁵ rows
+without touching the others), typed (float64, int64, bool, list<float64> per-pallet values:
+no CSV parsing or unit guessing), compressed, and readable by any tool (pandas, polars, DuckDB,
+R arrow, Spark). Appending is writing a new part file, so the driver never rewrites what is
+stored. Each part is written under a temporary name in the same folder and renamed with
+``os.replace`` (atomic on POSIX): a killed driver leaves complete part files only, and a
+resumed study reads the run ids already stored and runs the others.
+
+:func:`read_runs` deduplicates by ``run_id`` (a run stored twice, e.g. by a driver killed
+between writing a part and noticing it, counts once) and sorts by ``run_id``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+#: row columns in order: (name, pyarrow type name)
+COLUMNS = (
+    ("run_id", "string"), ("rack", "string"), ("record", "string"), ("im_measure", "string"),
+    ("im_target", "float64"), ("scale_factor", "float64"), ("stripe", "int64"),
+    ("mu_static", "float64"), ("mu_dynamic", "float64"), ("occupancy", "float64"),
+    ("seed", "int64"), ("status", "string"), ("error", "string"),
+    ("peak_sliding_max_m", "float64"), ("pallet_peak_sliding_m", "list<float64>"),
+    ("n_pallets", "int64"), ("any_fall", "bool"), ("n_fall", "int64"),
+    ("base_shear_N", "float64"), ("beam_displacement_max_m", "float64"),
+    ("drift_ratio_max", "float64"), ("upright_moment_connection_Nm", "float64"),
+    ("wall_time_s", "float64"),
+)
+RUNS_DIR = "runs"
+STUDY_JSON = "study.json"
+
+
+def schema():  # noqa: ANN201
+    """The pyarrow schema of a row table."""
+    import pyarrow as pa
+
+    types = {"string": pa.string(), "float64": pa.float64(), "int64": pa.int64(),
+             "bool": pa.bool_(), "list<float64>": pa.list_(pa.float64())}
+    return pa.schema([(name, types[t]) for name, t in COLUMNS])
+
+
+def rows_to_table(rows: list[dict[str, Any]]):  # noqa: ANN201
+    import pyarrow as pa
+
+    sch = schema()
+    return pa.table({name: pa.array([r[name] for r in rows], type=sch.field(name).type)
+                     for name in sch.names}, schema=sch)
+
+
+def write_part(out_dir: str | Path, rows: list[dict[str, Any]]) -> Path | None:
+    """Write ``rows`` as one part file, atomically; returns its path (None if no rows)."""
+    if not rows:
+        return None
+    import pyarrow.parquet as pq
+
+    runs = Path(out_dir) / RUNS_DIR
+    runs.mkdir(parents=True, exist_ok=True)
+    digest = hashlib.sha256("\n".join(sorted(r["run_id"] for r in rows)).encode()).hexdigest()
+    path = runs / f"part-{digest[:20]}.parquet"
+    tmp = runs / f".{path.name}.{os.getpid()}.tmp"
+    pq.write_table(rows_to_table(rows), tmp)
+    os.replace(tmp, path)
+    return path
+
+
+def part_files(out_dir: str | Path) -> list[Path]:
+    runs = Path(out_dir) / RUNS_DIR
+    return sorted(runs.glob("part-*.parquet")) if runs.is_dir() else []
+
+
+def stored_run_ids(out_dir: str | Path) -> set[str]:
+    """Ids of the runs already in the store (reads the ``run_id`` column only)."""
+    import pyarrow.parquet as pq
+
+    ids: set[str] = set()
+    for p in part_files(out_dir):
+        ids.update(pq.read_table(p, columns=["run_id"]).column(0).to_pylist())
+    return ids
+
+
+def read_runs(out_dir: str | Path):  # noqa: ANN201
+    """Every stored run as a ``pyarrow.Table``: one row per ``run_id``, sorted by ``run_id``."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    parts = [pq.read_table(p, schema=schema()) for p in part_files(out_dir)]
+    if not parts:
+        return schema().empty_table()
+    table = pa.concat_tables(parts).sort_by("run_id")
+    ids = np.asarray(table.column("run_id").to_pylist(), dtype=object)
+    if ids.size:
+        first = np.ones(ids.size, dtype=bool)
+        first[1:] = ids[1:] != ids[:-1]
+        if not first.all():
+            table = table.filter(pa.array(first))
+    return table
+
+
+def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa: ANN001
+    """``study.json``: the study file as given, the resolved inputs and the run table."""
+    from dataclasses import asdict
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {
+        "format": "seisrack-study/1",
+        "source": spec.source,
+        "study_toml": spec.text,
+        "title": spec.title,
+        "racks": list(spec.racks_as_given),
+        "dt": spec.dt,
+        "seed": spec.seed,
+        "intensity": {"measure": spec.intensity.measure,
+                      "levels_m_s2": list(spec.intensity.levels),
+                      "kind": "ida" if spec.intensity.is_ida else "stripes"},
+        "runs": [asdict(r) for r in runs],
+    }
+    path = out / STUDY_JSON
+    tmp = out / f".{STUDY_JSON}.{os.getpid()}.tmp"
+    tmp.write_text(json.dumps(doc, indent=1, allow_nan=True))
+    os.replace(tmp, path)
+    return path
