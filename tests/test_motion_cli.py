@@ -84,3 +84,17 @@ def test_generate_never_overwrites_without_force(
     assert written == ["EC8_type_1_ground_C_seed3.csv", "EC8_type_1_ground_C_seed4.csv"]
     assert main([*base, "--out", str(mine), "--force"]) == 0
     assert read_record(mine).accel.size > 100
+
+
+def test_check_folder_text_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder of records (issue #14 item 4): text report with the common scale factor."""
+    folder = tmp_path / "suite"
+    assert main(["motion", "generate", "--ag", "0.3", "--duration", "12", "--count", "3",
+                 "--seed", "5", "--out", str(folder)]) == 0
+    capsys.readouterr()
+    rc = main(["motion", "check", str(folder), "--type", "1", "--ground", "C", "--ag", "0.3",
+               "--period", "0.5", "--scale-suite"])
+    out = capsys.readouterr().out
+    assert "3 records" in out and "smallest common scale factor" in out
+    assert "after scaling every record by" in out
+    assert rc in (0, 1) and ("does NOT comply" in out.split("after scaling")[1]) == (rc == 1)

@@ -47,7 +47,7 @@ def register(subparsers: Any) -> None:
     c = sub.add_parser(
         "check", help="EN 1998-1 §3.2.3.1.2 report for a suite of records (files or folders)",
         description="Check a suite of accelerograms against EN 1998-1 §3.2.3.1.2: at least 3 "
-                    "records, mean PGA >= ag·S, mean 5%%-damped spectrum >= 90%% of the elastic "
+                    "records, mean PGA >= ag·S, mean 5%-damped spectrum >= 90% of the elastic "
                     "spectrum over 0.2 T1 - 2 T1, stationary part >= 10 s. Reports the smallest "
                     "common scale factor meeting the PGA and spectrum rules.")
     c.add_argument("files", nargs="+",
