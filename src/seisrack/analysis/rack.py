@@ -298,7 +298,7 @@ def run_rack(
         load-dependent Ritz basis above).
     save_every: keep every k-th sample of the histories (``None``: first and last only, for
         studies); peaks are always taken over every step. max_memory: bytes the histories may
-        take (default 80 % of the available memory); a longer run is refused up front.
+        take (default half of the available memory, at most 4 GiB); a longer run is refused up front.
     """
     if not isinstance(record, Record):
         raise InputError("record", type(record).__name__, "a seisrack.motion.Record")

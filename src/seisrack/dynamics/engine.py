@@ -35,6 +35,8 @@ _LOG = logging.getLogger(__name__)
 _MAX_SUBSTEPS = 512
 #: with ``basis="auto"``, structures up to this many DOFs keep every mode
 AUTO_FULL_MAX_DOF = 50
+#: default cap on what one run's kept histories and buffers may take [bytes]
+DEFAULT_MAX_MEMORY = 4 * 2**30
 #: steps integrated per kernel call (bounded working memory; the state carries over exactly)
 DEFAULT_CHUNK = 20_000
 
@@ -130,8 +132,8 @@ def simulate(
         ``None`` keeps only the first and last samples (peaks then come from ``on_chunk``).
     on_chunk : called with the full-rate :class:`Chunk` of each chunk of steps (for peaks or
         streaming without keeping the histories).
-    max_memory : bytes the kept histories and buffers may use (default: 80 % of the memory
-        available now); a larger run is refused before anything is allocated.
+    max_memory : bytes the kept histories and buffers may use (default: half of the memory
+        available now, at most 4 GiB); a larger run is refused before anything is allocated.
     """
     M = chk.square("M", M, None)
     n = M.shape[0]
@@ -361,7 +363,9 @@ def _check_memory(n_keep: int, chunk: int, nb: int, m: int, n_t: int,
             avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
         except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
             return
-        max_memory = 0.8 * avail
+        # a single run never takes more than half of what is free, nor more than
+        # DEFAULT_MAX_MEMORY: studies run several at once (ask for more with max_memory=)
+        max_memory = min(0.5 * avail, DEFAULT_MAX_MEMORY)
     if need > max_memory:
         raise InputError(
             "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "
