@@ -36,6 +36,7 @@ from seisrack.errors import InputError
 __all__ = [
     "FragilityFit",
     "bootstrap_fragility",
+    "bootstrap_ida_fragility",
     "fit_fragility",
     "fit_ida_fragility",
     "fragility_band",
@@ -357,3 +358,22 @@ def fit_ida_fragility(im_capacity) -> FragilityFit:
     se_u = beta / math.sqrt(finite.size) if finite.size >= 2 else math.nan
     se_b = beta / math.sqrt(2.0 * (finite.size - 1)) if finite.size >= 2 else math.nan
     return FragilityFit(theta, beta, math.nan, int(finite.size), status, r, se_u, se_b, "ida")
+
+
+def bootstrap_ida_fragility(im_capacity, n_boot: int = 200, seed: int = 0
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Bootstrap of :func:`fit_ida_fragility`: the records resampled with replacement.
+
+    Returns thetas, betas: (n_boot,), NaN where a resample has fewer than two finite capacities.
+    """
+    c = np.asarray(im_capacity, dtype=float).ravel()
+    rng = np.random.default_rng(seed)
+    thetas = np.full(int(n_boot), np.nan)
+    betas = np.full(int(n_boot), np.nan)
+    if c.size == 0:
+        return thetas, betas
+    for b in range(int(n_boot)):
+        fit = fit_ida_fragility(c[rng.integers(0, c.size, c.size)])
+        if fit.n_stripes >= 2:
+            thetas[b], betas[b] = fit.theta, fit.beta
+    return thetas, betas

@@ -1,0 +1,377 @@
+"""Post-processing of a study store: counts, EC8 suite means, fragility fits, IDA curves.
+
+Reads ``DIR/runs/*.parquet`` (one row per run, see :mod:`seisrack.studies.store`) and writes
+``DIR/summary/summary.json``, ``DIR/summary/fragility.csv`` and the figures ``fragility.png``
+(stripes) and ``ida.png`` (IDA). Only runs with status ``"ok"`` enter the statistics; failed
+runs are counted with their reasons.
+
+- *EC8 means.* EN 1998-1 §4.3.3.4.3: with 7 or more records the action effect is the mean over
+  the records, otherwise the most unfavourable. Per stripe, each peak is first averaged over the
+  runs of one record (friction samples, occupancy patterns), then the mean and the maximum over
+  the records are reported with ``n_records``; ``ec8`` is the mean if n_records >= 7, else the max.
+- *Fragility on stripes.* Binomial maximum likelihood (Baker 2015, Earthquake Spectra 31(1),
+  Eq. 11) for each damage state: ``sliding>d`` (``peak_sliding_max_m > d`` for each d),
+  ``any_fall``, and ``base_shear>V`` when a capacity V [N] is given. Bands: 5-95 % bootstrap
+  percentiles (runs resampled within each stripe).
+- *IDA* (``stripe == -1``): one curve per (record, friction, occupancy); the IM of first
+  exceedance per curve gives the method-of-moments fit, bootstrap over the curves.
+
+Theta is in the units of the intensity measure as stored: m/s² for both PGA and Sa.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import logging
+import math
+import sys
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from seisrack.errors import InputError, SeisrackError
+from seisrack.studies import fragility as fr
+
+__all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
+
+log = logging.getLogger(__name__)
+
+DEFAULT_D_SLIDE = (0.05,)  # [m]
+PEAKS = ("peak_sliding_max_m", "n_fall", "base_shear_N", "beam_displacement_max_m",
+         "drift_ratio_max", "upright_moment_connection_Nm")
+_STR = ("run_id", "rack", "record", "im_measure", "status", "error")
+_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS
+CSV_FIELDS = ("name", "theta", "beta", "theta_lo", "theta_hi", "beta_lo", "beta_hi",
+              "n_stripes", "n_runs", "rack", "im_measure", "method", "status")
+
+
+def read_runs_table(out_dir: str | Path):  # noqa: ANN201
+    """All stored runs as a ``pyarrow.Table``, one row per ``run_id``, sorted by ``run_id``.
+
+    Uses :func:`seisrack.studies.store.read_runs` when it is available; otherwise reads the
+    part files directly (same contract).
+    """
+    try:
+        from seisrack.studies.store import read_runs
+    except ImportError:  # the store module is optional for a reader
+        read_runs = _read_runs_local
+    return read_runs(out_dir)
+
+
+def _read_runs_local(out_dir: str | Path):  # noqa: ANN202
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    parts = sorted((Path(out_dir) / "runs").glob("part-*.parquet"))
+    if not parts:
+        return pa.table({"run_id": pa.array([], pa.string())})
+    table = pa.concat_tables([pq.read_table(p) for p in parts], promote_options="default")
+    table = table.sort_by("run_id")
+    ids = np.asarray(table.column("run_id").to_pylist(), dtype=object)
+    keep = np.ones(ids.size, dtype=bool)
+    keep[1:] = ids[1:] != ids[:-1]
+    return table.filter(pa.array(keep)) if not keep.all() else table
+
+
+def runs_as_arrays(table) -> dict[str, np.ndarray]:  # noqa: ANN001
+    """Columns needed here as numpy arrays: strings as object arrays ('' for null), numbers
+    as float64 (NaN for null). Missing columns are filled the same way."""
+    n = table.num_rows
+    out: dict[str, np.ndarray] = {}
+    names = set(table.column_names)
+    for c in _STR:
+        vals = table.column(c).to_pylist() if c in names else [None] * n
+        out[c] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
+    for c in _NUM:
+        vals = table.column(c).to_pylist() if c in names else [None] * n
+        out[c] = np.array([math.nan if v is None else float(v) for v in vals], dtype=float)
+    return out
+
+
+def _damage_states(d_slide, shear_capacity) -> list[tuple[str, str, float]]:
+    """(name, column, threshold): exceeding means column > threshold."""
+    states = [(f"sliding>{d:g}m", "peak_sliding_max_m", float(d)) for d in d_slide]
+    states.append(("any_fall", "any_fall", 0.5))
+    if shear_capacity is not None:
+        states.append((f"base_shear>{shear_capacity:g}N", "base_shear_N", float(shear_capacity)))
+    return states
+
+
+def _nan(x: float) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
+
+
+def _band_fields(fit, thetas, betas) -> dict[str, Any]:
+    good = np.isfinite(thetas) & np.isfinite(betas)
+    if good.sum() >= 2:
+        t_lo, t_hi = np.percentile(thetas[good], [5, 95])
+        b_lo, b_hi = np.percentile(betas[good], [5, 95])
+    else:
+        t_lo = t_hi = b_lo = b_hi = math.nan
+    return {"theta": _nan(fit.theta), "beta": _nan(fit.beta), "theta_lo": _nan(t_lo),
+            "theta_hi": _nan(t_hi), "beta_lo": _nan(b_lo), "beta_hi": _nan(b_hi),
+            "se_ln_theta": _nan(fit.se_ln_theta), "se_beta": _nan(fit.se_beta),
+            "n_stripes": fit.n_stripes, "n_runs": fit.n_runs, "status": fit.status,
+            "method": fit.method, "n_boot_ok": int(good.sum())}
+
+
+def _peaks(r: dict[str, np.ndarray], idx: np.ndarray) -> dict[str, Any]:
+    """EC8 statistics of each peak over the records of the rows ``idx``."""
+    recs = r["record"][idx]
+    names = sorted(set(recs))
+    out: dict[str, Any] = {}
+    for c in PEAKS:
+        per_rec = np.array([np.nanmean(r[c][idx][recs == nm]) if np.any(
+            np.isfinite(r[c][idx][recs == nm])) else math.nan for nm in names])
+        per_rec = per_rec[np.isfinite(per_rec)]
+        if per_rec.size == 0:
+            out[c] = {"mean": None, "max": None, "ec8": None}
+            continue
+        mean, mx = float(per_rec.mean()), float(per_rec.max())
+        out[c] = {"mean": mean, "max": mx, "ec8": mean if per_rec.size >= 7 else mx}
+    return out
+
+
+def _stripes(r, idx, states, n_boot, seed) -> dict[str, Any]:
+    ok = idx[r["status"][idx] == "ok"]
+    stripe_ids = np.unique(r["stripe"][idx]).astype(int)
+    stripes, im, n_ok = [], [], []
+    counts = {name: [] for name, _, _ in states}
+    for s in stripe_ids:
+        rows = idx[r["stripe"][idx] == s]
+        rows_ok = rows[r["status"][rows] == "ok"]
+        x = float(np.median(r["im_target"][rows]))
+        entry = {"stripe": int(s), "im": x, "n_runs": int(rows.size), "n_ok": int(rows_ok.size),
+                 "n_failed": int(rows.size - rows_ok.size),
+                 "n_records": len(set(r["record"][rows_ok])), "fraction": {},
+                 "peaks": _peaks(r, rows_ok)}
+        for name, col, thr in states:
+            k = int(np.count_nonzero(r[col][rows_ok] > thr))
+            counts[name].append(k)
+            entry["fraction"][name] = k / rows_ok.size if rows_ok.size else None
+        stripes.append(entry)
+        im.append(x)
+        n_ok.append(rows_ok.size)
+    fits = {}
+    for i, (name, _, _) in enumerate(states):
+        fit = fr.fit_fragility(im, n_ok, counts[name])
+        th, be = (fr.bootstrap_fragility(im, n_ok, counts[name], n_boot, seed + i)
+                  if fit.ok and n_boot > 0 else (np.full(0, np.nan), np.full(0, np.nan)))
+        fits[name] = _band_fields(fit, th, be)
+        fits[name]["_boot"] = (th, be)
+    return {"stripes": stripes, "fragility": fits, "n_ok": int(ok.size)}
+
+
+def _ida(r, idx, states, n_boot, seed) -> dict[str, Any]:
+    ok = idx[r["status"][idx] == "ok"]
+    keys = sorted({(r["record"][i], r["mu_static"][i], r["mu_dynamic"][i], r["occupancy"][i])
+                   for i in ok})
+    curves = []
+    for rec, mu_s, mu_d, occ in keys:
+        rows = ok[(r["record"][ok] == rec) & (r["mu_static"][ok] == mu_s)
+                  & (r["mu_dynamic"][ok] == mu_d) & (r["occupancy"][ok] == occ)]
+        rows = rows[np.argsort(r["im_target"][rows], kind="stable")]
+        cv = {"record": rec, "mu_static": _nan(mu_s), "occupancy": _nan(occ),
+              "im": r["im_target"][rows].tolist()}
+        for c in PEAKS + ("any_fall",):
+            cv[c] = [_nan(v) for v in r[c][rows]]
+        curves.append(cv)
+    fits = {}
+    for i, (name, col, thr) in enumerate(states):
+        cap = np.array([fr.ida_capacity(cv["im"], np.array(cv[col], dtype=float), thr)
+                        for cv in curves]) if curves else np.zeros(0)
+        fit = fr.fit_ida_fragility(cap)
+        th, be = fr.bootstrap_ida_fragility(cap, n_boot, seed + i)
+        fits[name] = _band_fields(fit, th, be)
+        fits[name]["capacities"] = [_nan(c) for c in cap]
+    return {"curves": curves, "fragility": fits, "n_ok": int(ok.size)}
+
+
+def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: float | None = None,
+              n_boot: int = 200, seed: int = 0, write: bool = True, plots: bool = True
+              ) -> dict[str, Any]:
+    """Summary of the study stored in ``out_dir`` (see the module docstring).
+
+    d_slide: sliding thresholds [m] (a float or a sequence); shear_capacity: base shear [N] for
+    the ``base_shear>V`` damage state (omitted when None); n_boot: bootstrap resamples per fit.
+    Returns the dict written to ``summary.json``.
+    """
+    out = Path(out_dir)
+    if not out.is_dir():
+        raise InputError("DIR", str(out), "a study output folder",
+                         hint="Run `seisrack study STUDY.toml --out DIR` first")
+    d_slide = (float(d_slide),) if np.isscalar(d_slide) else tuple(float(d) for d in d_slide)
+    if not d_slide or any(not (d > 0) for d in d_slide):
+        raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
+    if shear_capacity is not None and not (shear_capacity > 0):
+        raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
+    table = read_runs_table(out)
+    if table.num_rows == 0:
+        raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
+                         hint="The study has no finished run yet; run or resume it first")
+    r = runs_as_arrays(table)
+    states = _damage_states(d_slide, shear_capacity)
+    status = r["status"]
+    failed = status != "ok"
+    reasons = Counter((e.splitlines()[0][:160] if e else "(no reason recorded)")
+                      for e in r["error"][failed])
+    summary: dict[str, Any] = {
+        "out_dir": str(out), "runs_total": int(status.size), "runs_ok": int((~failed).sum()),
+        "runs_failed": int(failed.sum()), "failure_reasons": dict(reasons.most_common()),
+        "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
+        "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
+        "fragility": [],
+    }
+    groups = sorted({(a, b) for a, b in zip(r["rack"], r["im_measure"], strict=True)})
+    boot_store = []
+    for rack, meas in groups:
+        idx = np.flatnonzero((r["rack"] == rack) & (r["im_measure"] == meas))
+        g: dict[str, Any] = {"rack": rack, "im_measure": meas}
+        ms = idx[r["stripe"][idx] >= 0]
+        ida = idx[r["stripe"][idx] < 0]
+        if ms.size:
+            g["stripes"] = _stripes(r, ms, states, n_boot, seed)
+        if ida.size:
+            g["ida"] = _ida(r, ida, states, n_boot, seed)
+        for kind in ("stripes", "ida"):
+            for name, f in g.get(kind, {}).get("fragility", {}).items():
+                boot_store.append((rack, meas, kind, name, f.pop("_boot", None)))
+                row = {k: f[k] for k in CSV_FIELDS if k in f}
+                summary["fragility"].append({"name": name, "rack": rack, "im_measure": meas,
+                                             "analysis": kind, **row})
+        summary["groups"].append(g)
+    if write:
+        _write(out / "summary", summary, plots=plots, boots=boot_store)
+    return summary
+
+
+def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None:
+    folder.mkdir(parents=True, exist_ok=True)
+    files = {"summary_json": str(folder / "summary.json"),
+             "fragility_csv": str(folder / "fragility.csv")}
+    with open(folder / "fragility.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
+        w.writeheader()
+        for row in summary["fragility"]:
+            w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in w.fieldnames})
+    if plots:
+        files.update(_figures(folder, summary, boots))
+    summary["files"] = files
+    (folder / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False))
+
+
+def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    from seisrack.report.fragility_plot import plot_fragility, plot_ida
+
+    files = {}
+    ms = [g for g in summary["groups"] if "stripes" in g]
+    if ms:
+        fig, axes = plt.subplots(1, len(ms), figsize=(6.4 * len(ms), 4.4), squeeze=False)
+        for ax, g in zip(axes[0], ms, strict=True):
+            st = g["stripes"]["stripes"]
+            im = np.array([s["im"] for s in st])
+            grid = np.linspace(0.0, 1.6 * im.max(), 200)[1:]
+            for name, f in g["stripes"]["fragility"].items():
+                frac = [np.nan if s["fraction"][name] is None else s["fraction"][name] for s in st]
+                th, be = next((b for rk, m, k, nm, b in boots if (rk, m, k, nm)
+                               == (g["rack"], g["im_measure"], "stripes", name)), (None, None))
+                band = fr.fragility_band(grid, th, be) if th is not None and th.size else None
+                theta = math.nan if f["theta"] is None else f["theta"]
+                beta = math.nan if f["beta"] is None else f["beta"]
+                plot_fragility(im, frac, theta, beta, band=band, grid=grid, label=name,
+                               im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
+            ax.set_title(Path(g["rack"]).name, fontsize="small")
+        fig.tight_layout()
+        fig.savefig(folder / "fragility.png", dpi=120)
+        plt.close(fig)
+        files["fragility_png"] = str(folder / "fragility.png")
+    ida = [g for g in summary["groups"] if "ida" in g]
+    if ida:
+        fig, axes = plt.subplots(1, len(ida), figsize=(6.4 * len(ida), 4.4), squeeze=False)
+        for ax, g in zip(axes[0], ida, strict=True):
+            plot_ida(g["ida"]["curves"], im_label=f"{g['im_measure'].upper()} [m/s²]",
+                     threshold=summary["d_slide_m"][0], ax=ax)
+            ax.set_title(Path(g["rack"]).name, fontsize="small")
+        fig.tight_layout()
+        fig.savefig(folder / "ida.png", dpi=120)
+        plt.close(fig)
+        files["ida_png"] = str(folder / "ida.png")
+    return files
+
+
+def _fmt(x: Any, spec: str = ".3g") -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def format_summary(s: dict[str, Any]) -> str:
+    """A readable text summary of :func:`summarize`'s result."""
+    lines = [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
+             f"{s['runs_failed']} failed"]
+    for reason, n in s["failure_reasons"].items():
+        lines.append(f"  failed x{n}: {reason}")
+    for g in s["groups"]:
+        lines.append(f"\nrack {g['rack']}, IM = {g['im_measure']} [m/s²]")
+        if "stripes" in g:
+            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  falls")
+            for st in g["stripes"]["stripes"]:
+                pk = st["peaks"]["peak_sliding_max_m"]
+                nf = st["peaks"]["n_fall"]
+                lines.append(f"  {st['stripe']:6d} {st['im']:7.3g} "
+                             f"{st['n_ok']:4d}/{st['n_runs']:<4d} {st['n_records']:7d}  "
+                             f"{_fmt(pk['mean']):>9} / {_fmt(pk['max']):<9}"
+                             f" {_fmt(nf['mean'])}")
+        if "ida" in g:
+            lines.append(f"  IDA: {len(g['ida']['curves'])} curves")
+    lines.append("\nfragility (theta [m/s²], beta; 90 % bootstrap band)")
+    for f in s["fragility"]:
+        lines.append(f"  {f['analysis']:7s} {f['name']:22s} theta {_fmt(f['theta']):>7} "
+                     f"[{_fmt(f['theta_lo'])}, {_fmt(f['theta_hi'])}]  beta {_fmt(f['beta']):>6} "
+                     f"[{_fmt(f['beta_lo'])}, {_fmt(f['beta_hi'])}]  {f['status']}")
+    if "files" in s:
+        lines.append("\nwritten: " + ", ".join(s["files"].values()))
+    return "\n".join(lines)
+
+
+def summary_main(argv: list[str]) -> int:
+    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]``."""
+    p = argparse.ArgumentParser(prog="seisrack study summary",
+                                description="Summarise a study: counts, EC8 means, fragility.")
+    p.add_argument("dir", help="the study output folder (--out of `seisrack study`)")
+    p.add_argument("--d-slide", type=float, nargs="+", default=list(DEFAULT_D_SLIDE),
+                   metavar="D", help="sliding thresholds [m] (default 0.05)")
+    p.add_argument("--shear-capacity", type=float, default=None, metavar="N",
+                   help="base shear capacity [N] for the 'base shear > capacity' state")
+    p.add_argument("--boot", type=int, default=200, metavar="N", help="bootstrap resamples")
+    p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    p.add_argument("--no-plots", action="store_true", help="skip the figures")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    try:
+        a = p.parse_args(argv)
+    except SystemExit as exc:  # argparse already printed its usage message
+        return int(exc.code or 0)
+    if a.boot < 0:
+        print("error: --boot must be >= 0", file=sys.stderr)
+        return 2
+    try:
+        s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
+                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots)
+    except SeisrackError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except (OSError, ImportError, ValueError) as exc:  # unreadable part files
+        print(f"error: could not read the study in {a.dir}: {exc}", file=sys.stderr)
+        return 2
+    if a.json:
+        print(json.dumps(s, allow_nan=False))
+    else:
+        print(format_summary(s))
+    return 0
