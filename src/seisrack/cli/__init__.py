@@ -24,6 +24,7 @@ _COMMAND_MODULES = (
     "seisrack.cli.motion",
     "seisrack.cli.run",
     "seisrack.cli.paper",
+    "seisrack.cli.study",
     "seisrack.cli.export",
 )
 

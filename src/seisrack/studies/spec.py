@@ -169,7 +169,8 @@ def _records(t: Table, base: Path) -> RecordsSpec:
         folder_given = t.string("folder")
         fp = base / folder_given
         if not fp.is_dir():
-            raise t.error("folder", folder_given, f"an existing folder of records (looked for {fp})")
+            raise t.error("folder", folder_given,
+                          f"an existing folder of records (looked for {fp})")
         folder = str(fp)
     units = t.string("units", None) if t.has("units") else None
     if units is not None and units not in ("g", "m/s2"):
