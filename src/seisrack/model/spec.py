@@ -168,7 +168,7 @@ def with_friction(spec: RackSpec, mu_static: float, mu_dynamic: float | None = N
 
     ``mu_dynamic`` defaults to ``mu_static``. The values are validated like TOML input.
     """
-    from seisrack.model.load import check_friction
+    from seisrack.model._reader import check_friction
 
     mu_d = mu_static if mu_dynamic is None else mu_dynamic
     check_friction("mu_static", mu_static, "mu_dynamic", mu_d)
