@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -29,6 +29,13 @@ SLIDING_TOL_M = 1e-6
 DEFAULT_MAX_DT = 0.005
 #: friction coefficient used for the companion run with rigidly held pallets
 RIGID_MU = 1.0e6
+#: [Hz] default cut-off of the low-pass filter of the reported floor (beam) accelerations
+#: (docs/theory/floor_acceleration.md): above the sway modes that carry floor acceleration
+#: (0.5-10 Hz), below the pallets' local axial beam modes (100-130 Hz) and below the Nyquist
+#: frequency of records sampled at 50 Hz
+ACCEL_FILTER_HZ = 20.0
+#: order of the Butterworth low-pass, applied forward and backward (zero phase)
+ACCEL_FILTER_ORDER = 4
 
 
 @dataclass(frozen=True)
@@ -79,17 +86,41 @@ class RackResponse:
     rigid_beam_acceleration_peak: np.ndarray | None = None
     beam_acceleration_raw: np.ndarray | None = None
     full_peaks: dict[str, Any] | None = None
+    pallet_bay: np.ndarray | None = None
+    beam_acceleration_filtered: np.ndarray | None = None
+    acceleration_filter_hz: float = ACCEL_FILTER_HZ
+    operators: Any = field(default=None, repr=False)
 
     # ------------------------------------------------------------------ derived results
     @property
     def n_pallets(self) -> int:
         return int(self.pallet_mass.size)
 
+    def pallet_ids(self) -> list[int]:
+        """1-based pallet ids in input order (the order of the rack file / ``[loading]``)."""
+        return list(range(1, self.n_pallets + 1))
+
+    def pallet_slot(self) -> np.ndarray:
+        """(m,) 0-based position of each pallet within its (level, bay), left to right."""
+        bay = self._bay()
+        slot = np.zeros(self.n_pallets, dtype=int)
+        for j in range(self.n_pallets):
+            same = (self.pallet_level == self.pallet_level[j]) & (bay == bay[j])
+            slot[j] = int(np.sum(same & ((self.pallet_x < self.pallet_x[j]) | (
+                (self.pallet_x == self.pallet_x[j]) & (np.arange(self.n_pallets) < j)))))
+        return slot
+
+    def _bay(self) -> np.ndarray:
+        if self.pallet_bay is not None:
+            return np.asarray(self.pallet_bay, dtype=int)
+        return np.zeros(self.n_pallets, dtype=int)
+
     def pallet_labels(self) -> list[str]:
-        return [
-            f"P{j + 1} (level {int(self.pallet_level[j]) + 1}, x = {self.pallet_x[j]:.3f} m)"
-            for j in range(self.n_pallets)
-        ]
+        """Readable label of each pallet, ``"L{level}-B{bay}-S{slot}"`` (all 1-based; slot =
+        position within the bay and level, left to right)."""
+        bay, slot = self._bay(), self.pallet_slot()
+        return [f"L{int(self.pallet_level[j]) + 1}-B{int(bay[j]) + 1}-S{int(slot[j]) + 1}"
+                for j in range(self.n_pallets)]
 
     def pallet_peak_sliding(self) -> np.ndarray:
         """(m,) [m] peak |sliding| of each pallet."""
@@ -120,7 +151,9 @@ class RackResponse:
         return np.maximum(_ratio(pos, self.pallet_limit_pos), _ratio(neg, self.pallet_limit_neg))
 
     def pallets_at_risk(self) -> list[int]:
-        """0-based indices of pallets whose sliding reached their free distance (may fall)."""
+        """0-based indices of pallets whose sliding reached their free distance (may fall).
+
+        The summary (``summary()["pallets_at_risk"]``) lists the 1-based pallet ids instead."""
         return [int(j) for j in np.flatnonzero(self.fall_utilisation() >= 1.0)]
 
     def sliding_occurred(self) -> bool:
@@ -170,9 +203,12 @@ class RackResponse:
             mc = np.max(np.abs(conn)) if conn.size else 0.0
             total = np.max(np.abs(self.contact_force.sum(axis=1)))
             shear = np.max(np.abs(self.base_shear))
-        return {
+        acc_f = self.filtered_level_peak()
+        out = {
             "beam_displacement_m": float(disp.max()),
             "beam_acceleration_m_s2": float(acc.max()),
+            "beam_acceleration_filtered_m_s2": None if acc_f is None else float(acc_f.max()),
+            "acceleration_filter_hz": self.acceleration_filter_hz,
             "total_friction_force_N": float(total),
             "base_shear_N": float(shear),
             "upright_moment_base_Nm": float(mb),
@@ -182,9 +218,30 @@ class RackResponse:
             "per_level": {
                 "beam_displacement_m": disp.tolist(),
                 "beam_acceleration_m_s2": acc.tolist(),
+                "beam_acceleration_filtered_m_s2": None if acc_f is None else acc_f.tolist(),
                 "contact_force_N": force.tolist(),
             },
         }
+        design = self.design_peaks()
+        if design is not None:
+            out["interstorey_drift_ratio"] = design["interstorey_drift_ratio"]["max_abs"]
+            for key in ("beam_end_moment_Nm", "beam_end_shear_N", "connector_moment_Nm",
+                        "connector_rotation_rad", "upright_axial_force_N"):
+                out[key] = design[key]["max_abs"]
+        return out
+
+    def filtered_level_peak(self) -> np.ndarray | None:
+        """(n_level,) [m/s²] peak of the low-pass filtered absolute level accelerations over
+        every analysis step (``acceleration_filter_hz``), or None when not available."""
+        fp = self.full_peaks or {}
+        val = fp.get("beam_acceleration_filtered")
+        return None if val is None else np.asarray(val)
+
+    def design_peaks(self) -> dict[str, Any] | None:
+        """Design quantities per member and as peaks (see :func:`design_summary`)."""
+        from seisrack.analysis.peaks import design_summary
+
+        return design_summary(self)
 
     def _level_peak(self, name: str) -> np.ndarray:
         """(n_level,) peak |value| of a per-level history over every analysis step."""
@@ -206,10 +263,14 @@ class RackResponse:
             "status": self.status,
             "peaks": self.peaks(),
             "sliding_occurred": self.sliding_occurred(),
-            "pallets_at_risk": self.pallets_at_risk(),
+            "pallets_at_risk": [j + 1 for j in self.pallets_at_risk()],
             "pallets": [
                 {
+                    "id": j + 1,
                     "label": lab,
+                    "level": int(self.pallet_level[j]) + 1,
+                    "bay": int(self._bay()[j]) + 1,
+                    "x_m": float(self.pallet_x[j]),
                     "mass_kg": float(self.pallet_mass[j]),
                     "mu_static": float(self.pallet_mu_static[j]),
                     "mu_dynamic": float(self.pallet_mu_dynamic[j]),
@@ -223,6 +284,7 @@ class RackResponse:
                 for j, lab in enumerate(self.pallet_labels())
             ],
             "simplified_check": self.simplified_check(),
+            "design": self.design_peaks(),
             "n_events": len(self.events),
             "n_slip_events": n_slip,
             "energy_balance_error": self.history.energy_error() if self.energy else None,
@@ -281,6 +343,7 @@ def run_rack(
     save_every: int | None = 1,
     track_energy: bool = True,
     max_memory: float | None = None,
+    accel_filter_hz: float = ACCEL_FILTER_HZ,
 ) -> RackResponse:
     """Time history of ``model`` under the horizontal ground acceleration ``record``.
 
@@ -299,7 +362,13 @@ def run_rack(
     save_every: keep every k-th sample of the histories (``None``: first and last only, for
         studies); peaks are always taken over every step. max_memory: bytes the histories may
         take (default half of the available memory, at most 4 GiB); a longer run is refused up front.
+    accel_filter_hz: [Hz] cut-off of the zero-phase low-pass filter of the reported floor
+        accelerations (``beam_acceleration_filtered``; the raw ``beam_acceleration`` is kept),
+        applied to the full-rate level accelerations whatever ``save_every`` is.
     """
+    if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
+            and accel_filter_hz > 0):
+        raise InputError("accel_filter_hz", accel_filter_hz, "a frequency > 0 Hz")
     if not isinstance(record, Record):
         raise InputError("record", type(record).__name__, "a seisrack.motion.Record")
     if record.accel.size < 3:
@@ -345,7 +414,8 @@ def run_rack(
     ops = rack_operators(model, bas.phi)
     # the smoothing of Newmark's period-2h acceleration residue is decided after the run;
     # track both and keep the one that applies
-    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s) for s in (False, True)}
+    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s, keep_accel=True)
+                for s in (False, True)}
 
     def on_chunk(c) -> None:  # noqa: ANN001
         for t in trackers.values():
@@ -354,7 +424,13 @@ def run_rack(
     hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
                     save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
                     max_memory=max_memory)
-    peaks = trackers[hist.method == "newmark"].result()
+    tracker = trackers[hist.method == "newmark"]
+    peaks = tracker.result()
+    acc_full = tracker.level_acceleration()
+    del trackers, tracker
+    acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
+    peaks["beam_acceleration_filtered"] = (
+        None if acc_filt is None else np.abs(acc_filt).max(axis=0))
     rigid_peak = None
     if rigid_companion and model.n_pallets:
         rig = PeakTracker(ops, P, pallet_level, ag, h, smooth=False)
@@ -363,7 +439,34 @@ def run_rack(
         simulate(*mats, rigid_sl, **common, basis=bas, save_every=None, on_chunk=rig,
                  track_energy=False)
         rigid_peak = rig.result()["beam_acceleration"]
-    return _response(model, hist, ag, h, record.name, rigid_peak, ops, pallet_level, peaks)
+    resp = _response(model, hist, ag, h, record.name, rigid_peak, ops, pallet_level, peaks)
+    idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
+    return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
+                   beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx])
+
+
+def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
+    """Zero-phase Butterworth low-pass of ``a: (n_t, k)`` sampled every ``h`` [s] at ``fc`` [Hz].
+
+    ``scipy.signal.sosfiltfilt`` (forward and backward: no phase shift, so peaks stay at their
+    time; the magnitude response is the square of the order-``order`` filter's, -6 dB at fc).
+    A cut-off at or above the Nyquist frequency returns ``a`` unchanged.
+    """
+    from scipy.signal import butter, sosfiltfilt
+
+    a = np.asarray(a, dtype=float)
+    if fc >= 0.5 / h or a.shape[0] < 2:
+        return a.copy()
+    sos = butter(order, fc, btype="low", fs=1.0 / h, output="sos")
+    pad = min(3 * (2 * sos.shape[0] + 1), a.shape[0] - 1)
+    return sosfiltfilt(sos, a, axis=0, padlen=pad)
+
+
+def pallet_bays(model: FrameModel) -> np.ndarray:
+    """(m,) 0-based bay of each pallet, from its node's x between the uprights."""
+    x = np.asarray(model.nodes[model.pallet_node, 0], dtype=float)
+    ux = np.asarray(model.upright_x, dtype=float)
+    return np.clip(np.searchsorted(ux, x, side="right") - 1, 0, max(ux.size - 2, 0))
 
 
 def _basis_for(model: FrameModel, sliders: Sliders, basis: str, av) -> Basis:  # noqa: ANN001
@@ -452,4 +555,6 @@ def _response(
         history=hist,
         rigid_beam_acceleration_peak=rigid_peak,
         full_peaks=peaks,
+        pallet_bay=pallet_bays(model),
+        operators=ops,
     )

@@ -229,3 +229,130 @@ def _columns(rows: IntArray, cols: IntArray, vals: FloatArray, n_dof: int, n_col
     out.eliminate_zeros()
     out.sort_indices()
     return out
+
+
+@dataclass(frozen=True)
+class DesignOperators:
+    """Sparse maps from free-DOF displacements to the member forces a rack designer checks.
+
+    Each is ``(n_dof, k)`` CSR applied as ``U @ op`` (elastic forces only, conventions of the
+    module docstring), with one label per column:
+
+    Attributes:
+        beam_moment, beam_shear: (n_dof, n_level·n_bay·2) bending moment [N·m] (member
+            convention: ``-M_i`` at the left end, ``+M_j`` at the right end) and shear force [N]
+            (``V_i`` at the left end, ``-V_j`` at the right end, the same internal shear sign
+            on both ends) at the two ends of every beam; column ``(l·n_bay + b)·2 + e``,
+            e = 0 left, 1 right. ``beam_labels``: ``"L{l}-B{b}-left"`` (1-based).
+        connector_rotation, connector_moment: (n_dof, n_conn) relative rotation [rad] of each
+            beam-to-upright spring and its moment ``k·rotation`` [N·m], signed like the beam
+            end moment it carries (left end: beam minus upright rotation, right end: upright
+            minus beam), so that in equilibrium the connector moment equals the beam end
+            moment; ``connector_labels`` name that beam end (same labels as the beams).
+        axial: (n_dof, n_upright·(n_level + 1)) upright axial force [N], tension positive, at
+            the base (section 0) and at the top of the segment below each level (section l,
+            l = 1..n_level); column ``u·(n_level + 1) + s``. ``axial_labels``: ``"U{u}-base"``,
+            ``"U{u}-L{l}"``. The bending moment at the same sections is
+            ``RecoveryOperators.base_moment`` / ``below``.
+    """
+
+    beam_moment: sp.csr_matrix
+    beam_shear: sp.csr_matrix
+    beam_labels: tuple[str, ...]
+    connector_rotation: sp.csr_matrix
+    connector_moment: sp.csr_matrix
+    connector_labels: tuple[str, ...]
+    axial: sp.csr_matrix
+    axial_labels: tuple[str, ...]
+
+
+def design_operators(model: Any) -> DesignOperators:
+    """Build the :class:`DesignOperators` of a FrameModel (beam ends, connectors, upright N)."""
+    mesh = _mesh(model)
+    n = mesh.n_dof
+    edofs = mesh.element_dofs
+    c, s = mesh.direction_cosines
+    kt = np.einsum("eij,ejk->eik", local_stiffness(mesh.E, mesh.A, mesh.I, mesh.lengths),
+                   rotation(c, s))
+    kind = np.asarray(model.element_kind)
+    storey = np.asarray(model.element_storey)
+    line = np.asarray(model.element_line)
+    ux = np.asarray(model.upright_x, dtype=float)
+    n_lev, n_bay = len(model.level_dofs), ux.size - 1
+    xi = mesh.nodes[mesh.elements[:, 0], 0]
+    xj = mesh.nodes[mesh.elements[:, 1], 0]
+    tol = 1e-9 * max(1.0, float(np.ptp(ux)))
+    beam = kind == 1
+    # the end element of each beam: its i node on the left upright / its j node on the right
+    left = np.full((n_lev, n_bay), -1, dtype=np.int64)
+    right = np.full((n_lev, n_bay), -1, dtype=np.int64)
+    for e in np.flatnonzero(beam & (np.abs(xi - ux[np.clip(line, 0, n_bay)]) < tol)):
+        left[storey[e], line[e]] = e
+    for e in np.flatnonzero(beam & (np.abs(xj - ux[np.clip(line + 1, 0, n_bay)]) < tol)):
+        right[storey[e], line[e]] = e
+    ends = np.stack([left, right], axis=-1).ravel()  # (l, b, e) order
+    comp_m = np.tile([2, 5], n_lev * n_bay)
+    comp_v = np.tile([1, 4], n_lev * n_bay)
+    sign = np.tile([-1.0, 1.0], n_lev * n_bay)
+    beam_m = _end_rows(kt, edofs, ends, comp_m, sign, n)
+    beam_v = _end_rows(kt, edofs, ends, comp_v, -sign, n)
+    beam_labels = tuple(f"L{lv + 1}-B{b + 1}-{side}" for lv in range(n_lev)
+                        for b in range(n_bay) for side in ("left", "right"))
+
+    # connectors: springs between two free rotation DOFs, the second on a beam end node
+    node_of_rot = np.full(n + 1, -1, dtype=np.int64)
+    rot = mesh.node_dofs[:, 2]
+    node_of_rot[rot[rot >= 0]] = np.flatnonzero(rot >= 0)
+    end_of_node: dict[int, int] = {}
+    for k, e in enumerate(ends):
+        if e >= 0:
+            end_of_node[int(mesh.elements[e, k % 2])] = k
+    springs = np.asarray(mesh.springs)
+    cols, labels, ks = [], [], []
+    for si, (a, b) in enumerate(springs):
+        if a < 0 or b < 0:
+            continue
+        for up, bm in ((a, b), (b, a)):
+            k = end_of_node.get(int(node_of_rot[bm]), -1)
+            if k >= 0:
+                cols.append((up, bm))
+                labels.append(beam_labels[k])
+                ks.append(float(mesh.spring_k[si]))
+                break
+    order = np.argsort([beam_labels.index(lab) for lab in labels], kind="stable")
+    cols = [cols[i] for i in order]
+    labels = [labels[i] for i in order]
+    ks = np.asarray([ks[i] for i in order])
+    nc = len(cols)
+    r_rows = np.array([[bm, up] for up, bm in cols], dtype=np.int64).reshape(-1)
+    r_cols = np.repeat(np.arange(nc), 2)
+    # sign of the beam's member convention: the connector moment equals the beam end moment
+    # (equilibrium of the beam end node, no external moment there) and the rotation follows it
+    side = np.array([1.0 if lab.endswith("left") else -1.0 for lab in labels])
+    r_vals = np.repeat(side, 2) * np.tile([1.0, -1.0], nc)
+    conn_rot = _columns(r_rows, r_cols, r_vals, n, nc)
+    conn_m = _columns(r_rows, r_cols, r_vals * np.repeat(ks, 2), n, nc)
+
+    n_up = ux.size
+    sec = np.empty((n_up, n_lev + 1), dtype=np.int64)
+    sec[:, 0] = np.asarray(model.upright_base_elements)
+    sec[:, 1:] = np.asarray(model.upright_below_elements)
+    comp_n = np.tile(np.r_[0, np.full(n_lev, 3)], n_up)
+    sign_n = np.tile(np.r_[-1.0, np.ones(n_lev)], n_up)  # tension positive: -N_i, +N_j
+    axial = _end_rows(kt, edofs, sec.ravel(), comp_n, sign_n, n)
+    axial_labels = tuple(f"U{u + 1}-" + ("base" if s_ == 0 else f"L{s_}")
+                         for u in range(n_up) for s_ in range(n_lev + 1))
+    return DesignOperators(beam_moment=beam_m, beam_shear=beam_v, beam_labels=beam_labels,
+                           connector_rotation=conn_rot, connector_moment=conn_m,
+                           connector_labels=tuple(labels), axial=axial,
+                           axial_labels=axial_labels)
+
+
+def _end_rows(kt: FloatArray, edofs: IntArray, elems: IntArray, comp: IntArray,
+              factor: FloatArray, n_dof: int) -> sp.csr_matrix:
+    """Like :func:`_element_rows` with a component and a factor per column."""
+    ok = elems >= 0
+    cols = np.repeat(np.flatnonzero(ok), 6)
+    e = elems[ok]
+    vals = factor[ok, None] * kt[e, comp[ok], :]
+    return _columns(edofs[e].ravel(), cols, vals.ravel(), n_dof, elems.size)
