@@ -26,6 +26,7 @@ _COMMAND_MODULES = (
     "seisrack.cli.paper",
     "seisrack.cli.study",
     "seisrack.cli.export",
+    "seisrack.cli.report",
 )
 
 

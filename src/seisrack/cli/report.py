@@ -1,0 +1,106 @@
+"""``seisrack report RACK.toml --motion FILE``: run a rack and write the engineer's HTML report.
+
+Thin: load the rack and the record (with ``seisrack run``'s helpers), run the time history, the
+modal analysis and the design checks, then write ``report.html`` and ``summary.json`` beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "report", help="run a rack under a record and write a self-contained HTML report",
+        description="Run the earthquake time history of a rack, its modal analysis and the "
+                    "design checks (FEM 10.2.08 / EN 16681 pallet sliding, EN 1998-1 θ, the "
+                    "paper's mu >= alpha rule), and write one self-contained HTML file (opens "
+                    "offline, prints on A4) plus summary.json beside it. Units: SI.")
+    p.add_argument("rack", help="rack description (TOML)")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--motion", metavar="FILE",
+                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
+    src.add_argument("--builtin", metavar="NAME", help="a bundled record (e.g. elcentro_1940_ns)")
+    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2'")
+    p.add_argument("--motion-dt", type=float, metavar="DT",
+                   help="[s] time step of a one-column record file")
+    p.add_argument("--mu", type=float, metavar="MU",
+                   help="static (and dynamic) friction coefficient of every pallet")
+    p.add_argument("--ec8", nargs=3, metavar=("TYPE", "GROUND", "AG"),
+                   help="EC8 design spectrum for the FEM sliding check and the spectrum figure: "
+                        "type 1|2, ground A-E, a_g in g (default: the record's own spectrum)")
+    p.add_argument("--modes", type=int, default=6, metavar="N",
+                   help="modes in the modal table and the checks (default 6)")
+    p.add_argument("--out", default="report.html", metavar="FILE.html",
+                   help="the HTML report (default report.html); summary.json goes beside it")
+    p.add_argument("--force", action="store_true", help="overwrite an existing report")
+    p.add_argument("--json", action="store_true",
+                   help="print the summary with the design checks as one JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from seisrack.analysis import run_rack
+    from seisrack.checks import run_design_checks
+    from seisrack.cli._common import print_json
+    from seisrack.cli.run import _records
+    from seisrack.errors import InputError
+    from seisrack.fe.modal import modal_analysis
+    from seisrack.model import compile_rack, load_rack, with_friction
+    from seisrack.report.html import check_report_path, write_html_report
+    from seisrack.report.rack_io import SUMMARY_FILE, write_summary_json
+
+    if args.mu is not None and not (args.mu >= 0):
+        raise InputError("--mu", args.mu, "a friction coefficient >= 0")
+    if args.modes < 1:
+        raise InputError("--modes", args.modes, "an integer >= 1")
+    out = check_report_path(args.out, args.force, field="--out")
+    summary_path = out.with_name(SUMMARY_FILE)
+    if summary_path.exists() and not args.force:
+        raise InputError("--out", str(summary_path), "a folder without summary.json",
+                         hint="Pass --force to overwrite it")
+    design = _design_spectrum(args.ec8)
+    vars(args).setdefault("vertical", None)
+    spec = load_rack(args.rack)
+    if args.mu is not None:
+        spec = with_friction(spec, args.mu)
+    model = compile_rack(spec)
+    rec, _ = _records(args)
+    resp = run_rack(model, rec)
+    modal = modal_analysis(model, n_modes=min(args.modes, model.n_dof))
+    checks = run_design_checks(model, resp, modal=modal, spectrum=design, record=rec)
+    summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
+               "integration": resp.history.method, "basis": resp.history.basis}
+    summary["design_checks"] = checks
+    write_html_report(out, spec=spec, model=model, response=resp, record=rec, summary=summary,
+                      modal=modal, checks=checks, force=args.force, design_spectrum=design,
+                      rack_file=args.rack)
+    summary["outputs"] = [str(out), str(summary_path)]
+    write_summary_json(summary, summary_path)
+    if args.json:
+        print_json(summary)
+    else:
+        print(f"report: {out}\nsummary: {summary_path}")
+        for c in checks["checks"]:
+            print(f"  {c['title']}: {c['verdict']}")
+        for d in checks["disagreements"]:
+            print(f"  DISAGREES with the time history: {d}")
+    return 0
+
+
+def _design_spectrum(ec8: list[str] | None) -> Any:
+    if ec8 is None:
+        return None
+    from seisrack.errors import InputError
+    from seisrack.motion import ec8_spectrum
+
+    kind, ground, ag = ec8
+    try:
+        ag_v = float(ag)
+    except ValueError:
+        raise InputError("--ec8 AG", ag, "a design ground acceleration in g > 0") from None
+    return ec8_spectrum(kind, ground.upper(), ag_v)
+
+
+__all__ = ["register", "run"]
