@@ -3,7 +3,7 @@
 - the store's schema is the contract the post-processing reads (column names and types);
 - one small study (12 runs of the paper rack, 3 s records) on 1 worker, on 2 workers and on a
   Dask LocalCluster of 2 workers gives identical tables, bit for bit, in every column but
-  ``wall_time_s``;
+  ``wall_time_s``, and so does a cluster given by its scheduler address;
 - every row is consistent with a direct ``run_rack`` of the same scaled record and friction
   (peak sliding, base shear, falls);
 - a run that fails (made to fail through the test hook) is a row with status "failed", its
@@ -140,3 +140,15 @@ def test_cli_runs_then_resumes(study: Path, reference: pa.Table, tmp_path: Path,
     doc = json.loads((out / "study.json").read_text())
     assert len(doc["runs"]) == 12 and "stripes" in doc["study_toml"]
     assert _comparable(read_runs(out)) == _comparable(reference)
+
+
+@pytest.mark.slow
+def test_dask_scheduler_address_same_table(study: Path, reference: pa.Table,
+                                           tmp_path: Path) -> None:
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        s = run_study(load_study(study), tmp_path, scheduler=cluster.scheduler_address,
+                      progress=False)
+    assert s.executor == "dask" and s.runs_ok == 12
+    assert _comparable(read_runs(tmp_path)) == _comparable(reference)

@@ -248,6 +248,8 @@ values = [0.4]
     (("values = [0.4]", 'dist = "uniform"\nlow = 0.5\nhigh = 0.3'), "friction.high"),
     (("values = [0.4]", 'dist = "truncnormal"\nmean = 0.4\nstd = 0\nlow = 0.1\nhigh = 0.6'),
      "friction.std"),
+    (("values = [0.4]", 'dist = "truncnormal"\nmean = 0.4\nstd = 0.01\nlow = 2\nhigh = 3'),
+     "friction.low"),
     (("values = [0.4]", 'dist = "weibull"'), "friction.dist"),
     (("values = [0.4]", "values = [0.4]\ndynamic_ratio = 1.5"), "friction.dynamic_ratio"),
     (("values = [0.4]", "values = [0.4, 0.4]"), "friction.values"),

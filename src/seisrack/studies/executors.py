@@ -252,7 +252,13 @@ class DaskExecutor:
 
         cluster = None
         if self.scheduler:
-            client = Client(self.scheduler)
+            try:
+                client = Client(self.scheduler, timeout="20s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                from seisrack.errors import InputError
+
+                raise InputError("scheduler", self.scheduler, "the address of a running Dask "
+                                 "scheduler, e.g. tcp://10.0.0.1:8786", hint=str(exc)) from None
         else:
             cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)

@@ -289,6 +289,14 @@ def _friction(t: Table) -> FrictionSpec:
         if params["high"] <= params["low"]:
             raise t.error("high", params["high"], f"a value > low ({params['low']:g})")
         keys = ("mean", "std", "low", "high")
+        from scipy.special import ndtr
+
+        mass = ndtr((params["high"] - params["mean"]) / params["std"]) - ndtr(
+            (params["low"] - params["mean"]) / params["std"])
+        if not mass > 1e-9:
+            raise t.error("low", params["low"], "an interval [low, high] holding some "
+                          f"probability of the normal(mean {params['mean']:g}, std "
+                          f"{params['std']:g}) distribution")
     else:
         raise t.error("dist", dist, ", ".join(DISTRIBUTIONS))
     t.finish(("dist", "samples", "dynamic_ratio") + keys)
