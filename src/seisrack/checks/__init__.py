@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from seisrack.checks.drift import drift_sensitivity_check, theta_verdict
+from seisrack.checks.drift import drift_sensitivity_check, sensitivity_theta, theta_verdict
 from seisrack.checks.factors import FACTOR_SOURCES, CheckFactors
 from seisrack.checks.sliding import level_accelerations, pallet_sliding_check
 
@@ -30,6 +30,7 @@ __all__ = [
     "mu_alpha_check",
     "pallet_sliding_check",
     "run_design_checks",
+    "sensitivity_theta",
     "theta_verdict",
 ]
 

@@ -38,6 +38,11 @@ def theta_verdict(theta: float, f: CheckFactors) -> tuple[str, bool]:
     return f"θ > {f.theta_max:g}: not allowed", False
 
 
+def sensitivity_theta(P_tot: float, d_r: float, V_tot: float, h: float) -> float:
+    """θ = P_tot · d_r / (V_tot · h), EN 1998-1 Eq. (4.28) [N, m, N, m -> -]; 0 if V_tot = 0."""
+    return float(P_tot * d_r / (V_tot * h)) if V_tot > 0 else 0.0
+
+
 def storey_gravity_loads(model: Any) -> np.ndarray:
     """(n_storey,) [N] gravity load at and above each storey (members + pallets).
 
@@ -47,8 +52,10 @@ def storey_gravity_loads(model: Any) -> np.ndarray:
     m_v = np.asarray(model.M_sparse @ model.r_y).ravel()  # (n_dof,) [kg] on uy DOFs
     nd = model.mesh.node_dofs
     free = nd[:, 1] >= 0
-    y = model.mesh.nodes[free, 1]
-    m = m_v[nd[free, 1]]
+    # nodes of a semi-rigid joint share their translational DOFs: count each uy DOF once
+    dofs, first = np.unique(nd[free, 1], return_index=True)
+    y = model.mesh.nodes[free, 1][first]
+    m = m_v[dofs]
     bottoms = np.concatenate([[0.0], np.asarray(model.level_y, dtype=float)[:-1]])
     tol = 1e-9 * max(1.0, float(np.max(model.level_y)))
     return np.array([float(model.g) * m[y > b + tol].sum() for b in bottoms])
@@ -94,7 +101,7 @@ def drift_sensitivity_check(model: Any, response: Any, factors: CheckFactors | N
     rows = []
     ok_all = True
     for s in range(h.size):
-        theta = float(P[s] * d_r[s] / (V[s] * h[s])) if V[s] > 0 else 0.0
+        theta = sensitivity_theta(P[s], d_r[s], V[s], h[s])
         text, ok = theta_verdict(theta, f)
         ok_all &= ok
         rows.append({"storey": s + 1, "height_m": float(h[s]), "P_tot_N": float(P[s]),

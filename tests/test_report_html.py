@@ -1,0 +1,151 @@
+"""The engineer's HTML report (seisrack.report.html) and ``seisrack report``, without a browser:
+self-contained file, the numbers of summary.json in the tables, overwrite and bad-path errors,
+static fallback without plotly. ``test_report_browser.py`` renders it in Chromium."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from seisrack.errors import InputError
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def build_case(mu: float | None = None, seconds: float = 6.0) -> dict:
+    """The three-level example rack under the first seconds of the bundled El Centro record."""
+    from seisrack.analysis import run_rack
+    from seisrack.checks import run_design_checks
+    from seisrack.fe.modal import modal_analysis
+    from seisrack.model import compile_rack, load_rack, with_friction
+    from seisrack.motion import Record, ec8_spectrum, load_builtin_record
+
+    spec = load_rack(EXAMPLES / "three_level_rack.toml")
+    if mu is not None:
+        spec = with_friction(spec, mu)
+    model = compile_rack(spec)
+    full = load_builtin_record("elcentro_1940_ns")
+    n = int(round(seconds / full.dt)) + 1
+    rec = Record(np.asarray(full.accel[:n]), full.dt, name="elcentro_first_6s")
+    resp = run_rack(model, rec)
+    modal = modal_analysis(model, n_modes=4)
+    design = ec8_spectrum(1, "C", 0.3)
+    checks = run_design_checks(model, resp, modal=modal, spectrum=design, record=rec)
+    summary = {"rack": "examples/three_level_rack.toml", "title": spec.title, **resp.summary()}
+    summary["design_checks"] = checks
+    # as summary.json holds it (JSON round trip: tuples -> lists, inf -> Infinity)
+    summary = json.loads(json.dumps(summary, default=float))
+    return dict(spec=spec, model=model, response=resp, record=rec, summary=summary,
+                modal=modal, checks=checks, design_spectrum=design)
+
+
+@pytest.fixture(scope="module")
+def case():
+    pytest.importorskip("matplotlib")
+    return build_case()
+
+
+def test_report_is_self_contained_with_every_section(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    out = write_html_report(tmp_path / "r.html", **case, rack_file="rack.toml", seed=7)
+    text = out.read_text(encoding="utf-8")
+    for sec in ("inputs", "elevation", "modal", "record", "histories", "tables", "checks"):
+        assert f'<section id="{sec}">' in text
+    # no external resource: every src is inline, no stylesheet links, no remote scripts
+    assert not re.search(r'<(script|img|link|iframe)[^>]+(src|href)="(https?:)?//', text)
+    assert "<link" not in text
+    assert text.count('src="data:image/png;base64,') >= 4
+    assert "seisrack version" in text and ">7<" in text  # the seed
+    # every figure has a caption
+    assert text.count("<figure") == text.count("<figcaption>")
+    assert "@page { size: A4" in text and "break-before: page" in text
+
+
+def test_tables_hold_the_numbers_of_summary(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    text = write_html_report(tmp_path / "r.html", **case).read_text(encoding="utf-8")
+    s = case["summary"]
+    for j, p in enumerate(s["pallets"]):
+        row = re.search(rf'<tr[^>]*data-pallet="{j}">(.*?)</tr>', text, re.S).group(1)
+        for key in ("peak_sliding_m", "residual_m", "fall_utilisation", "mass_kg"):
+            val = re.search(rf'data-key="{key}" data-value="([^"]+)"', row).group(1)
+            assert json.loads(val) == p[key]
+    per = s["peaks"]["per_level"]
+    for i in range(len(per["beam_displacement_m"])):
+        row = re.search(rf'<tr data-level="{i}">(.*?)</tr>', text, re.S).group(1)
+        for key, vals in per.items():
+            val = re.search(rf'data-key="{key}" data-value="([^"]+)"', row).group(1)
+            assert json.loads(val) == vals[i]
+
+
+def test_disagreement_is_flagged(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    text = write_html_report(tmp_path / "r.html", **case).read_text(encoding="utf-8")
+    if case["checks"]["disagreements"]:
+        assert "Checks that disagree with the time history" in text
+    for c in case["checks"]["checks"]:
+        assert f'id="check-{c["name"]}"' in text
+
+
+def test_refuses_to_overwrite_without_force(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    path = tmp_path / "r.html"
+    path.write_text("old")
+    with pytest.raises(InputError, match=re.escape(str(path))):
+        write_html_report(path, **case)
+    assert path.read_text() == "old"
+    write_html_report(path, **case, force=True)
+    assert path.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+
+
+def test_unwritable_path_is_a_clear_error(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    with pytest.raises(InputError, match="existing folder"):
+        write_html_report(tmp_path / "no" / "such" / "r.html", **case)
+    with pytest.raises(InputError, match="folder"):
+        write_html_report(tmp_path, **case)
+    if os.geteuid() != 0:  # root writes anywhere
+        ro = tmp_path / "ro"
+        ro.mkdir(mode=0o500)
+        with pytest.raises(InputError, match="writable"):
+            write_html_report(ro / "r.html", **case)
+
+
+def test_static_fallback_without_plotly(case, tmp_path):
+    from seisrack.report.html import write_html_report
+
+    text = write_html_report(tmp_path / "r.html", **case, interactive=False).read_text(
+        encoding="utf-8")
+    assert "<script" not in text
+    assert re.search(r'<figure id="fig-histories"><img src="data:image/png;base64,', text)
+
+
+def test_cli_report_writes_html_and_summary(tmp_path, capsys):
+    from seisrack.cli import main
+
+    out = tmp_path / "rep" / "report.html"
+    out.parent.mkdir()
+    rc = main(["report", str(EXAMPLES / "three_level_rack.toml"), "--builtin",
+               "elcentro_1940_ns", "--ec8", "1", "C", "0.3", "--out", str(out), "--json"])
+    assert rc == 0
+    printed = json.loads(capsys.readouterr().out)
+    on_disk = json.loads((out.parent / "summary.json").read_text())
+    assert printed["design_checks"]["checks"][0]["name"] == "pallet_sliding_fem"
+    assert on_disk["pallets"] == printed["pallets"]
+    assert out.stat().st_size > 0
+    # a second run refuses to overwrite, --force overwrites
+    assert main(["report", str(EXAMPLES / "three_level_rack.toml"), "--builtin",
+                 "elcentro_1940_ns", "--out", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert main(["report", str(EXAMPLES / "three_level_rack.toml"), "--builtin",
+                 "elcentro_1940_ns", "--out", str(out), "--force"]) == 0
