@@ -89,7 +89,8 @@ def response_dataset(
                                  "horizontal displacement of the beam level relative to the "
                                  "ground (mean of its nodes)"),
         "beam_acceleration": var(("time", "level"), resp.beam_acceleration, "m s-2",
-                                 "absolute horizontal acceleration of the beam level"),
+                                 "absolute horizontal acceleration of the beam level (raw, "
+                                 "unfiltered)"),
         "contact_force": var(("time", "level"), resp.contact_force, "N",
                              "total horizontal contact force of the beams on the pallets of "
                              "the level"),
@@ -105,11 +106,22 @@ def response_dataset(
                                          "upright bending moment at the beam connection "
                                          "(larger of the segments below / above)"),
     }
+    if resp.beam_acceleration_filtered is not None:
+        data["beam_acceleration_filtered"] = var(
+            ("time", "level"), resp.beam_acceleration_filtered, "m s-2",
+            f"absolute horizontal acceleration of the beam level, low-pass filtered at "
+            f"{resp.acceleration_filter_hz:g} Hz (zero-phase 4th-order Butterworth)",
+            filter_hz=float(resp.acceleration_filter_hz))
+    _design_variables(resp, coords, data, var)
     if m:
         hist = resp.history
         coords.update({
             "pallet": var(("pallet",), np.arange(1, m + 1, dtype=np.int32), "1",
-                          "pallet number (order of the rack file)"),
+                          "pallet id (1-based, order of the rack file; as in summary.json)"),
+            "pallet_label": var(("pallet",), np.array(resp.pallet_labels()), "1",
+                                "pallet label L{level}-B{bay}-S{slot} (1-based)"),
+            "pallet_bay": var(("pallet",), (resp._bay() + 1).astype(np.int32), "1",
+                              "bay the pallet stands in, 1 = leftmost"),
             "pallet_level": var(("pallet",), (resp.pallet_level + 1).astype(np.int32), "1",
                                 "beam level the pallet stands on"),
             "pallet_x": var(("pallet",), resp.pallet_x, "m", "position of the pallet's node"),
@@ -184,6 +196,43 @@ def write_timehistory(
                                                              format="NETCDF3_64BIT"))
 
 
+#: (netCDF variable, DesignOps attribute, dimension, units, long name) of the design histories
+_DESIGN_VARS = (
+    ("interstorey_drift_ratio", "drift", "storey", "1",
+     "interstorey drift ratio (gravity + seismic)"),
+    ("beam_end_moment", "beam_moment", "beam_end", "N m",
+     "beam end bending moment (member convention, gravity + seismic, elastic)"),
+    ("beam_end_shear", "beam_shear", "beam_end", "N",
+     "beam end shear force (gravity + seismic, elastic)"),
+    ("connector_moment", "connector_moment", "connector", "N m",
+     "beam-to-upright connector moment (gravity + seismic)"),
+    ("connector_rotation", "connector_rotation", "connector", "rad",
+     "beam-to-upright connector rotation (gravity + seismic)"),
+    ("upright_axial_force", "axial", "section", "N",
+     "upright axial force, tension positive (gravity + seismic, elastic)"),
+    ("upright_section_moment", "section_moment", "section", "N m",
+     "upright bending moment at the axial-force sections (gravity + seismic, elastic)"),
+)
+
+
+def _design_variables(resp: RackResponse, coords: dict[str, Any], data: dict[str, Any],
+                      var: Callable[..., Any]) -> None:
+    """Add the design-quantity histories (and their member labels) when the run has them."""
+    ops = getattr(resp, "operators", None)
+    if ops is None or ops.design is None:
+        return
+    from seisrack.analysis.peaks import design_history
+
+    d = ops.design
+    for name, attr, dim, units, long_name in _DESIGN_VARS:
+        labels = d.labels[attr]
+        if not labels:
+            continue
+        if f"{dim}_label" not in coords:
+            coords[f"{dim}_label"] = var((dim,), np.array(labels), "1", f"{dim} label")
+        data[name] = var(("time", dim), design_history(resp, attr), units, long_name)
+
+
 # ---------------------------------------------------------------------------------- peaks
 def _peak(x: np.ndarray, t: np.ndarray) -> tuple[float, float]:
     """(max |x|, time of it) over axis 0 of a 1-D series."""
@@ -212,7 +261,11 @@ def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
         v, tt = _peak(resp.beam_displacement[:, lv], t)
         add("beam_displacement", v, "m", time=tt, level=lv + 1, note="relative to the ground")
         v, tt = _peak(resp.beam_acceleration[:, lv], t)
-        add("beam_acceleration", v, "m/s2", time=tt, level=lv + 1, note="absolute")
+        add("beam_acceleration", v, "m/s2", time=tt, level=lv + 1, note="absolute, raw")
+        if resp.beam_acceleration_filtered is not None:
+            v, tt = _peak(resp.beam_acceleration_filtered[:, lv], t)
+            add("beam_acceleration_filtered", v, "m/s2", time=tt, level=lv + 1,
+                note=f"absolute, low-pass {resp.acceleration_filter_hz:g} Hz")
         v, tt = _peak(resp.contact_force[:, lv], t)
         add("contact_force", v, "N", time=tt, level=lv + 1, note="beams on pallets, this level")
     v, tt = _peak(resp.contact_force.sum(axis=1), t)
@@ -225,13 +278,22 @@ def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
         for lv in range(n_level):
             v, tt = _peak(resp.upright_moment_connection[:, u, lv], t)
             add("upright_moment_connection", v, "N*m", time=tt, level=lv + 1, upright=u + 1)
+    design = resp.design_peaks()
+    if design is not None:
+        from seisrack.analysis.peaks import DESIGN_KEYS
+
+        for key, _, unit, _ in DESIGN_KEYS:
+            item = design[key]
+            for lab, val in zip(item["labels"], item.get("peak_abs", []), strict=True):
+                add(key, float(val), unit.replace(" ", "*"), note=f"{lab}, gravity + seismic")
     util = resp.fall_utilisation()
     residual = resp.pallet_residual()
+    labels = resp.pallet_labels()
     for j in range(resp.n_pallets):
         lv = int(resp.pallet_level[j]) + 1
         v, tt = _peak(resp.pallet_sliding[:, j], t)
         add("pallet_sliding", v, "m", time=tt, level=lv, pallet=j + 1,
-            note="relative to its beam")
+            note=f"{labels[j]}, relative to its beam")
         add("pallet_residual", float(residual[j]), "m", time=float(t[-1]), level=lv,
             pallet=j + 1, note="signed, end of record")
         v, tt = _peak(resp.pallet_friction[:, j], t)
