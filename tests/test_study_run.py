@@ -9,7 +9,8 @@
 - a run that fails (made to fail through the test hook) is a row with status "failed", its
   reason and NaN peaks, and the study goes on;
 - ``read_runs`` keeps one row per run id when a run is stored twice, sorted by id;
-- ``seisrack study ... --json`` runs the study and a second call runs nothing (resume).
+- ``seisrack study ... --json`` runs the study and a second call runs nothing (resume);
+  ``seisrack study summary DIR --json`` reaches the summary with the run counts.
 """
 
 from __future__ import annotations
@@ -152,3 +153,16 @@ def test_dask_scheduler_address_same_table(study: Path, reference: pa.Table,
                       progress=False)
     assert s.executor == "dask" and s.runs_ok == 12
     assert _comparable(read_runs(tmp_path)) == _comparable(reference)
+
+
+def test_cli_study_summary_dispatch(study: Path, tmp_path: Path,
+                                    capsys: pytest.CaptureFixture) -> None:
+    pytest.importorskip("seisrack.studies.summary")
+    from seisrack.cli import main
+
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--workers", "1", "--json"]) == 0
+    capsys.readouterr()
+    assert main(["study", "summary", str(out), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["runs_total"] == 12 and doc["runs_ok"] == 12 and doc["runs_failed"] == 0
