@@ -23,6 +23,9 @@ demo: $(STAMP)
 	$(BIN)/seisrack paper --out out/paper
 
 test: $(STAMP)
+	# the HTML report's browser test drives Debian's chromium (about 25 s to install here)
+	if command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && ! command -v chromium >/dev/null; \
+	   then apt-get update -qq && apt-get install -y -qq chromium; fi
 	$(BIN)/python -m ruff check src tests benchmarks
 	$(BIN)/python -m pytest -n 2 -q tests
 
