@@ -82,13 +82,13 @@ def _run_study(args: argparse.Namespace) -> int:
         raise InputError("--workers", args.workers, "an integer >= 1")
     if args.batch_size is not None and args.batch_size < 1:
         raise InputError("--batch-size", args.batch_size, "an integer >= 1")
+    if not args.out and not args.dry_run:
+        raise InputError("--out", None, "a folder for the study results",
+                         hint="Add --out DIR (or --dry-run to see the runs)")
     spec = load_study(args.study)
     pl = plan(spec)
     if args.dry_run:
         return _dry_run(args, spec, pl)
-    if not args.out:
-        raise InputError("--out", None, "a folder for the study results",
-                         hint="Add --out DIR (or --dry-run to see the runs)")
     from seisrack.studies.store import write_study_json
 
     write_study_json(args.out, spec, pl.runs)
