@@ -98,7 +98,7 @@ def _describe(resp: RackResponse, key: str, level: int | None, pallet: int) -> s
         n = resp.beam_displacement.shape[1]
         return f"beam level {(n - 1 if level is None else level) + 1}"
     if per == "pallet":
-        return f"pallet {resp.pallet_labels()[pallet]}"
+        return f"pallet {pallet + 1} ({resp.pallet_labels()[pallet]})"
     if per == "total":
         return "sum over all pallets"
     return ""
@@ -168,7 +168,7 @@ def plot_pallet_sliding(
     sel = list(range(resp.n_pallets)) if pallets is None else list(pallets)
     labels = resp.pallet_labels()
     for j in sel:
-        plot_rack_history(resp, "pallet_sliding", ax, pallet=j, label=labels[j],
+        plot_rack_history(resp, "pallet_sliding", ax, pallet=j, label=f"{j + 1} {labels[j]}",
                           color=f"C{j % 10}")
         if limits:
             ax.axhline(resp.pallet_limit_pos[j] * 1e3, color=f"C{j % 10}", ls="--", lw=0.7)
@@ -216,3 +216,197 @@ def save_fig16(
 
 #: file names written by :func:`save_fig16`
 FIG16_FILES = tuple(f"{_QUANTITIES[k][5]}.png" for k in FIG16)
+
+
+# ------------------------------------------------------------------ the user's rack (issue 14)
+#: file names written by :func:`save_rack_figures`, named after what they show
+RACK_FIGURES = ("beam_displacement.png", "beam_acceleration.png", "contact_force.png",
+                "pallet_sliding.png", "sliding_heatmap.png")
+
+
+def _level_colours(n: int) -> list[Any]:
+    import matplotlib
+
+    cmap = matplotlib.colormaps["viridis"]
+    return [cmap(0.9 * i / max(n - 1, 1)) for i in range(n)]
+
+
+def _level_legend_or_bar(ax: Any, n: int, max_legend: int = 8) -> None:
+    """A legend for a few levels, a discrete colour bar of level numbers for many."""
+    if n <= max_legend:
+        ax.legend(fontsize=7, loc="upper right", ncol=1 if n <= 4 else 2)
+        return
+    import matplotlib as mpl
+
+    norm = mpl.colors.BoundaryNorm(np.arange(0.5, n + 1.5), n)
+    sm = mpl.cm.ScalarMappable(norm=norm, cmap=mpl.colors.ListedColormap(_level_colours(n)))
+    ax.figure.colorbar(sm, ax=ax, label="beam level", ticks=range(1, n + 1, max(1, n // 10)))
+
+
+def plot_levels(resp: RackResponse, quantity: str, ax: Any = None) -> Any:
+    """A per-level history (``beam_displacement``, ``beam_acceleration`` (raw) or
+    ``beam_acceleration_filtered``, ``contact_force``) of every level, coloured by level."""
+    ax = _axes(ax)
+    scale, unit, title = {
+        "beam_displacement": (1e3, "beam displacement [mm]",
+                              "Horizontal displacement of each beam level (relative to the "
+                              "ground)"),
+        "beam_acceleration": (1.0, "beam acceleration [m/s²]",
+                              "Absolute acceleration of each beam level (raw)"),
+        "beam_acceleration_filtered": (
+            1.0, "beam acceleration [m/s²]",
+            f"Absolute acceleration of each beam level, low-pass "
+            f"{resp.acceleration_filter_hz:g} Hz"),
+        "contact_force": (1e-3, "contact force [kN]",
+                          "Horizontal contact force of the beams on the pallets, per level"),
+    }[quantity]
+    arr = getattr(resp, quantity)
+    n = arr.shape[1]
+    for lv, c in enumerate(_level_colours(n)):
+        ax.plot(resp.t, arr[:, lv] * scale, lw=0.7, color=c, label=f"level {lv + 1}")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(unit)
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.axhline(0.0, color="k", lw=0.4)
+    _level_legend_or_bar(ax, n)
+    return ax
+
+
+def plot_all_pallet_sliding(resp: RackResponse, ax: Any = None) -> Any:
+    """Sliding history of every pallet, coloured by its level (a colour bar, no legend)."""
+    ax = _axes(ax)
+    n = resp.beam_displacement.shape[1]
+    cols = _level_colours(n)
+    for j in range(resp.n_pallets):
+        ax.plot(resp.t, resp.pallet_sliding[:, j] * 1e3, lw=0.6,
+                color=cols[int(resp.pallet_level[j])],
+                label=f"level {int(resp.pallet_level[j]) + 1}")
+    lim_p = float(np.min(resp.pallet_limit_pos, initial=np.inf))
+    lim_n = float(np.min(resp.pallet_limit_neg, initial=np.inf))
+    if np.isfinite(lim_p) and np.isfinite(lim_n):
+        ax.axhline(lim_p * 1e3, color="r", ls="--", lw=0.7)
+        ax.axhline(-lim_n * 1e3, color="r", ls="--", lw=0.7)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("pallet sliding [mm]")
+    ax.set_title(f"Sliding of the {resp.n_pallets} pallets relative to their beams, coloured "
+                 "by level\ndashed: smallest free distance before a pallet falls", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if n <= 8:  # one legend entry per level
+        handles, labels = ax.get_legend_handles_labels()
+        seen = dict(zip(labels, handles, strict=True))
+        ax.legend(seen.values(), seen.keys(), fontsize=7, loc="upper right")
+    else:
+        _level_legend_or_bar(ax, n)
+    return ax
+
+
+def sliding_grid(resp: RackResponse) -> tuple[np.ndarray, np.ndarray, int]:
+    """(n_level, n_bay·n_slot) grids of peak sliding [m] and of pallet id (0 = empty cell),
+    rows = levels bottom to top, columns = (bay, slot) left to right; and n_slot."""
+    n_level = resp.beam_displacement.shape[1]
+    bay, slot = resp._bay(), resp.pallet_slot()
+    n_bay = int(bay.max()) + 1 if resp.n_pallets else 1
+    n_slot = int(slot.max()) + 1 if resp.n_pallets else 1
+    val = np.full((n_level, n_bay * n_slot), np.nan)
+    ids = np.zeros((n_level, n_bay * n_slot), dtype=int)
+    peak = resp.pallet_peak_sliding()
+    for j in range(resp.n_pallets):
+        r, c = int(resp.pallet_level[j]), int(bay[j]) * n_slot + int(slot[j])
+        val[r, c] = peak[j]
+        ids[r, c] = j + 1
+    return val, ids, n_slot
+
+
+def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 80) -> Any:
+    """Peak sliding of every pallet on a level × (bay, slot) grid, with a colour bar [mm].
+
+    Cells are labelled with the pallet id when there are at most ``annotate`` pallets; a
+    pallet whose sliding reached its free distance is outlined in red. Returns the Axes.
+    """
+    ax = _axes(ax)
+    val, ids, n_slot = sliding_grid(resp)
+    n_level, n_col = val.shape
+    masked = np.ma.masked_invalid(val * 1e3)
+    im = ax.imshow(masked, origin="lower", aspect="auto", cmap="magma_r",
+                   vmin=0.0, vmax=max(float(masked.max()) if masked.count() else 0.0, 1e-3))
+    ax.figure.colorbar(im, ax=ax, label="peak sliding [mm]")
+    risk = set(resp.pallets_at_risk())
+    for (r, c), pid in np.ndenumerate(ids):
+        if pid and pid - 1 in risk:
+            ax.add_patch(__import__("matplotlib").patches.Rectangle(
+                (c - 0.5, r - 0.5), 1, 1, fill=False, ec="red", lw=1.5))
+        if pid and resp.n_pallets <= annotate:
+            ax.text(c, r, str(pid), ha="center", va="center", fontsize=6, color="0.5")
+    n_bay = n_col // n_slot
+    for b in range(1, n_bay):
+        ax.axvline(b * n_slot - 0.5, color="k", lw=0.6)
+    step = max(1, n_bay // 20)
+    ax.set_xticks([b * n_slot + (n_slot - 1) / 2 for b in range(0, n_bay, step)])
+    ax.set_xticklabels([str(b + 1) for b in range(0, n_bay, step)], fontsize=7)
+    ax.set_yticks(range(0, n_level, max(1, n_level // 20)))
+    ax.set_yticklabels([str(lv + 1) for lv in range(0, n_level, max(1, n_level // 20))],
+                       fontsize=7)
+    ax.set_xlabel(f"bay (each split in {n_slot} slot{'s' if n_slot > 1 else ''}, left to right)")
+    ax.set_ylabel("beam level")
+    ax.set_title("Peak sliding of each pallet (numbers: pallet id; red: reached its free "
+                 "distance)", fontsize=10)
+    return ax
+
+
+def existing_figures(out_dir: str | Path) -> list[Path]:
+    """The files of :data:`RACK_FIGURES` already present in ``out_dir``."""
+    return [Path(out_dir) / f for f in RACK_FIGURES if (Path(out_dir) / f).exists()]
+
+
+def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, suptitle: str | None = None,
+                      force: bool = False) -> list[Path]:
+    """Write the figures of the user's rack (:data:`RACK_FIGURES`, all levels) into ``out_dir``.
+
+    An existing figure is never overwritten unless ``force``: raises ``InputError`` naming
+    ``--force`` before anything is written.
+    """
+    out = Path(out_dir)
+    there = existing_figures(out)
+    if there and not force:
+        from seisrack.errors import InputError
+
+        raise InputError("--force", False, "--force to overwrite existing figures",
+                         hint="These figures exist: " + ", ".join(str(p) for p in there))
+    n_level = resp.beam_displacement.shape[1]
+    height = 3.4 + 0.12 * max(0, n_level - 4)
+    paths = []
+
+    def finish(ax: Any, name: str) -> None:
+        if suptitle:
+            ax.figure.suptitle(suptitle, fontsize=9)
+        save(ax, str(out / name))
+        paths.append(out / name)
+
+    ax = _axes(None)
+    ax.figure.set_size_inches(7.5, height)
+    finish(plot_levels(resp, "beam_displacement", ax), RACK_FIGURES[0])
+    ax = _axes(None)
+    ax.figure.set_size_inches(7.5, height)
+    if resp.beam_acceleration_filtered is not None:
+        plot_levels(resp, "beam_acceleration_filtered", ax)
+        raw = float(np.max(np.abs(resp.beam_acceleration), initial=0.0))
+        ax.set_title(ax.get_title() + f"\nraw (unfiltered) peak of the kept samples: "
+                     f"{raw:.2f} m/s²", fontsize=10)
+    else:
+        plot_levels(resp, "beam_acceleration", ax)
+    finish(ax, RACK_FIGURES[1])
+    ax = _axes(None)
+    ax.figure.set_size_inches(7.5, height)
+    finish(plot_levels(resp, "contact_force", ax), RACK_FIGURES[2])
+    for name, draw in ((RACK_FIGURES[3], plot_all_pallet_sliding),
+                       (RACK_FIGURES[4], plot_sliding_heatmap)):
+        ax = _axes(None)
+        ax.figure.set_size_inches(7.5, height if name != RACK_FIGURES[4]
+                                  else 2.0 + 0.35 * n_level)
+        if resp.n_pallets:
+            draw(resp, ax)
+        else:
+            ax.set_title("no pallets")
+        finish(ax, name)
+    return paths
