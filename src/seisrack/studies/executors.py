@@ -274,6 +274,9 @@ class DaskExecutor:
 
         from dask.distributed import Client, LocalCluster, as_completed
 
+        if not log.isEnabledFor(logging.INFO):  # dask sets its loggers to INFO: quiet them
+            for name in ("distributed", "dask"):
+                logging.getLogger(name).setLevel(logging.WARNING)
         cluster = None
         if self.scheduler:
             try:
@@ -285,7 +288,7 @@ class DaskExecutor:
                                  "scheduler, e.g. tcp://10.0.0.1:8786", hint=str(exc)) from None
         else:
             cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=None, silence_logs=logging.WARNING)
             client = Client(cluster)
         try:
             ctx = client.scatter(self.ctx, broadcast=True)
