@@ -30,10 +30,21 @@ _COMMAND_MODULES = (
 )
 
 
+#: set by :func:`main` when the command line asks for ``--json``: errors are JSON too
+_JSON_ERRORS = False
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse parser whose usage errors exit with code 2 and a one-line message."""
+    """argparse parser whose usage errors exit with code 2 and a one-line message (a JSON
+    error object on stdout under ``--json``)."""
 
     def error(self, message: str) -> None:  # pragma: no cover - exercised via CLI tests
+        if _JSON_ERRORS:
+            from seisrack.cli._common import error_object, print_json_error
+
+            print_json_error(error_object(message=f"{self.prog}: {message}",
+                                          allowed="see --help"))
+            self.exit(2)
         self.print_usage(sys.stderr)
         self.exit(2, f"seisrack: error: {message}\n")
 
@@ -58,6 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    global _JSON_ERRORS
+    _JSON_ERRORS = "--json" in (sys.argv[1:] if argv is None else list(argv))
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -71,17 +84,30 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(func(args) or 0)
     except SeisrackError as exc:
-        print(f"seisrack: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(exc, str(exc))
     except FileNotFoundError as exc:
-        print(f"seisrack: error: file not found: {exc.filename}", file=sys.stderr)
-        return 2
+        return _error(exc, f"file not found: {exc.filename}", "file", exc.filename,
+                      "an existing file")
     except IsADirectoryError as exc:
-        print(f"seisrack: error: expected a file, got a directory: {exc.filename}", file=sys.stderr)
-        return 2
+        return _error(exc, f"expected a file, got a directory: {exc.filename}", "file",
+                      exc.filename, "a file")
     except PermissionError as exc:
-        print(f"seisrack: error: permission denied: {exc.filename}", file=sys.stderr)
-        return 2
+        return _error(exc, f"permission denied: {exc.filename}", "file", exc.filename,
+                      "a readable/writable path")
     except KeyboardInterrupt:
         print("seisrack: interrupted", file=sys.stderr)
         return 130
+
+
+def _error(exc: BaseException, message: str, field: str | None = None, value: object = None,
+           allowed: str | None = None) -> int:
+    """Report a user error: one paragraph on stderr, or a JSON object on stdout with --json."""
+    if _JSON_ERRORS:
+        from seisrack.cli._common import error_object, print_json_error
+
+        obj = (error_object(exc) if hasattr(exc, "field") else
+               error_object(message=message, field=field, value=value, allowed=allowed))
+        print_json_error(obj)
+    else:
+        print(f"seisrack: error: {message}", file=sys.stderr)
+    return 2

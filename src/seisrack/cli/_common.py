@@ -47,3 +47,31 @@ def float_list(text: str) -> list[float]:
     if not vals:
         raise argparse.ArgumentTypeError("expected at least one number")
     return vals
+
+
+def error_object(exc: BaseException | None = None, *, message: str | None = None,
+                 field: str | None = None, value: Any = None, allowed: str | None = None
+                 ) -> dict[str, Any]:
+    """``{"error": {"field", "value", "allowed", "message"}}`` for ``--json`` (issue #14).
+
+    From an :class:`~seisrack.errors.InputError` the fields are its own; other errors give
+    ``null`` for what they do not know. ``value`` is made JSON-able (``repr`` as a last resort).
+    """
+    if exc is not None:
+        field = getattr(exc, "field", field)
+        value = getattr(exc, "value", value)
+        allowed = getattr(exc, "allowed", allowed) or allowed
+        message = message or str(exc)
+    val = _to_jsonable(value)
+    try:
+        json.dumps(val, allow_nan=False)
+    except (TypeError, ValueError):
+        val = repr(value)
+    return {"error": {"field": field, "value": val, "allowed": allowed or None,
+                      "message": message or ""}}
+
+
+def print_json_error(obj: dict[str, Any]) -> None:
+    """Print the JSON error object on stdout (the exit code is the caller's: 2)."""
+    json.dump(obj, sys.stdout, indent=2, allow_nan=False)
+    sys.stdout.write("\n")

@@ -20,10 +20,12 @@ PROGRESS_MIN_STEPS = 20_000
 _OUT_HELP = (
     "folder for the results (created if needed): timehistory.nc (netCDF, all time histories), "
     "peaks.csv, summary.json and, with --plot (the default with --out), "
-    "fig16a_displacement.png, fig16b_acceleration.png, fig16c_contact_force.png, "
-    "fig16d_sliding.png. Files of these names are overwritten; nothing else in the folder is "
-    "touched"
+    "beam_displacement.png, beam_acceleration.png, contact_force.png, pallet_sliding.png, "
+    "sliding_heatmap.png (every level). The data files of these names are overwritten; "
+    "existing figures only with --force; nothing else in the folder is touched"
 )
+#: [m/s²] a record PGA above this draws a warning (issue #14: implausible input)
+PGA_WARN_G = 3.0
 
 
 def register(subparsers: Any) -> None:
@@ -71,7 +73,13 @@ def register(subparsers: Any) -> None:
                    help="[s] of free vibration after the record (default 0)")
     p.add_argument("--out", metavar="DIR", help=_OUT_HELP)
     p.add_argument("--plot", action=argparse.BooleanOptionalAction, default=None,
-                   help="write the Fig. 16a-d PNGs into --out DIR (default: yes with --out)")
+                   help="write the figures (PNG, every level and a sliding heat map) into "
+                        "--out DIR (default: yes with --out)")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite figures that already exist in --out DIR")
+    p.add_argument("--accel-filter", type=float, default=None, metavar="HZ",
+                   help="[Hz] cut-off of the low-pass filter of the reported floor "
+                        "accelerations (default 20; the raw peak is reported too)")
     p.add_argument("--json", action="store_true",
                    help="print one JSON object (the summary) instead of the text report")
     _register_scaling(p)
@@ -125,6 +133,9 @@ def _check_options(args: argparse.Namespace) -> None:
         raise InputError("--save-every", args.save_every, "an integer >= 1")
     if args.plot and not args.out:
         raise InputError("--plot", True, "used together with --out DIR (figures go there)")
+    if args.accel_filter is not None:
+        _check_number("--accel-filter", args.accel_filter, "a frequency > 0 Hz",
+                      args.accel_filter > 0)
 
 
 def _read(path: str, option: str, args: argparse.Namespace) -> Any:
@@ -252,9 +263,46 @@ def _apply_scaling(args: argparse.Namespace, model: Any, rec: Any,
         vert = scale_by(vert, info["factor"])
         info["vertical_pga_after"] = vert.pga
     if new.pga > PGA_WARN:
-        print(f"seisrack: warning: the scaled record's PGA is {new.pga:.3g} m/s² = "
-              f"{new.pga / G:.2f} g, above 3 g; check the scaling target", file=sys.stderr)
+        warn(f"the scaled record's PGA is {new.pga:.3g} m/s² = {new.pga / G:.2f} g, above "
+             "3 g; check the scaling target")
     return new, vert, info
+
+
+def warn(message: str) -> None:
+    """A warning on stderr: implausible but accepted input (never an error)."""
+    print(f"seisrack: warning: {message}", file=sys.stderr)
+
+
+def _input_warnings(rec: Any, vert: Any, g: float, scaled: bool) -> None:
+    """Warn on implausible records (issue #14): PGA above 3 g, vertical below -g."""
+    from seisrack.motion import G
+
+    if not scaled and rec.pga > PGA_WARN_G * G:
+        warn(f"the record's PGA is {rec.pga:.3g} m/s² = {rec.pga / G:.2f} g, above "
+             f"{PGA_WARN_G:g} g; check --units (g or m/s2)")
+    if vert is not None:
+        low = float(min(vert.accel))
+        if low < -g:
+            warn(f"the vertical acceleration reaches {low:.3g} m/s², below -g = {-g:.3g} "
+                 "m/s²: the pallets would lift off; the model clips their normal force at 0 "
+                 "and does not follow them in the air")
+
+
+def _result_warnings(resp: Any, model: Any) -> None:
+    """Warn when a pallet slid further than the rack is long (the results are not physical
+    beyond a fall: the model keeps a fallen pallet on its beam)."""
+    import numpy as np
+
+    if not resp.n_pallets:
+        return
+    length = float(np.ptp(model.upright_x))
+    peak = resp.pallet_peak_sliding()
+    far = [j + 1 for j in np.flatnonzero(peak > length)]
+    if far:
+        warn(f"pallet(s) {', '.join(map(str, far[:20]))}{' ...' if len(far) > 20 else ''} "
+             f"slid more than the rack's length ({length:.3g} m): they fell long before; "
+             "sliding beyond the free distance is not physical (the model keeps a pallet on "
+             "its beam)")
 
 
 # ------------------------------------------------------------------------------ run
@@ -273,6 +321,7 @@ def run(args: argparse.Namespace) -> int:
     model = compile_rack(spec)
     rec, vert = _records(args)
     rec, vert, scaling = _apply_scaling(args, model, rec, vert)
+    _input_warnings(rec, vert, model.g, scaling is not None)
     try:
         k = analysis_grid(rec, args.dt)
     except InputError as exc:
@@ -284,6 +333,14 @@ def run(args: argparse.Namespace) -> int:
         if plot:
             _need("matplotlib", "--plot", True, "plot")
         out = _prepare_out(args.out)
+        if plot and not args.force:
+            from seisrack.report.rack_plot import existing_figures
+
+            there = existing_figures(out)
+            if there:
+                raise InputError("--out", args.out, "a folder without seisrack figures, or "
+                                 "--force to overwrite them",
+                                 hint="Existing: " + ", ".join(p.name for p in there))
 
     n_pad = int(round(args.free_vibration / rec.dt))
     n_steps = (rec.n - 1 + n_pad) * k
@@ -293,11 +350,14 @@ def run(args: argparse.Namespace) -> int:
                         free_vibration=args.free_vibration, method=args.method,
                         basis=args.basis, save_every=args.save_every,
                         rigid_companion=args.rigid_check,
-                        progress=None if bar is None else bar.update)
+                        progress=None if bar is None else bar.update,
+                        **({} if args.accel_filter is None
+                           else {"accel_filter_hz": args.accel_filter}))
     finally:
         if bar is not None:
             bar.close()
 
+    _result_warnings(resp, model)
     summary = resp.summary()
     summary = {"rack": args.rack, "title": spec.title, **summary,
                "integration": resp.history.method, "basis": resp.history.basis}
@@ -305,7 +365,7 @@ def run(args: argparse.Namespace) -> int:
         scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
         summary["scaling"] = scaling
     if out is not None:
-        _write_outputs(resp, model, spec, summary, out, plot)  # adds summary["outputs"]
+        _write_outputs(resp, model, spec, summary, out, plot, args.force)  # adds "outputs"
     if args.json:
         print_json(summary)
     else:
@@ -326,7 +386,7 @@ def _progress_bar(n_steps: int) -> Any:
 
 
 def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], out: Path,
-                   plot: bool) -> list[Path]:
+                   plot: bool, force: bool = False) -> list[Path]:
     from seisrack.report import rack_io
 
     title = spec.title or Path(summary["rack"]).stem
@@ -336,9 +396,10 @@ def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], ou
         rack_io.write_peaks_csv(resp, out / rack_io.PEAKS_FILE),
     ]
     if plot:
-        from seisrack.report.rack_plot import save_fig16
+        from seisrack.report.rack_plot import save_rack_figures
 
-        written += save_fig16(resp, out, suptitle=f"{title} - {resp.record_name}")
+        written += save_rack_figures(resp, out, suptitle=f"{title} - {resp.record_name}",
+                                     force=force)
     summary_path = out / rack_io.SUMMARY_FILE
     written.append(summary_path)
     summary["outputs"] = [str(p) for p in written]
@@ -372,8 +433,12 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
     cap = float(np.sum(resp.pallet_mu_dynamic * resp.pallet_mass)) * g
     rows = [
         ("beam displacement (relative to ground)", pk["beam_displacement_m"] * 1e3, "mm"),
-        ("beam acceleration (absolute)", pk["beam_acceleration_m_s2"], "m/s²",
+        ("beam acceleration (absolute, raw)", pk["beam_acceleration_m_s2"], "m/s²",
          f"= {pk['beam_acceleration_m_s2'] / g:.3f} g"),
+        *([] if pk.get("beam_acceleration_filtered_m_s2") is None else [
+            (f"beam acceleration (low-pass {pk['acceleration_filter_hz']:g} Hz)",
+             pk["beam_acceleration_filtered_m_s2"], "m/s²",
+             f"= {pk['beam_acceleration_filtered_m_s2'] / g:.3f} g")]),
         ("total pallet-beam contact force", pk["total_friction_force_N"] / 1e3, "kN",
          f"(μd·M·g = {cap / 1e3:.3f} kN, M = {m_tot:.0f} kg)" if resp.n_pallets else ""),
         ("base shear", pk["base_shear_N"] / 1e3, "kN"),
@@ -385,24 +450,27 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
     for name, val, unit, *note in rows:
         lines.append(f"  {name:<38} {val:>10.3f} {unit:<5} {note[0] if note else ''}".rstrip())
     if len(pk["per_level"]["beam_displacement_m"]) > 1:
+        filt = pk["per_level"].get("beam_acceleration_filtered_m_s2")
         for lv, (d, a) in enumerate(zip(pk["per_level"]["beam_displacement_m"],
                                         pk["per_level"]["beam_acceleration_m_s2"],
                                         strict=True)):
+            fa = "" if filt is None else f", filtered {filt[lv]:.3f} m/s²"
             lines.append(f"    level {lv + 1}: displacement {d * 1e3:.3f} mm, "
-                         f"acceleration {a:.3f} m/s²")
+                         f"acceleration raw {a:.3f} m/s²{fa}")
+    lines.extend(_design_lines(summary.get("design")))
     lines.append("")
     if resp.n_pallets:
         lines.append("Pallets (sliding relative to the beam; limit = free distance -x / +x)")
-        lines.append(f"  {'#':>3} {'level':>5} {'x [m]':>7} {'mass [kg]':>9} {'mu_s':>5} "
+        lines.append(f"  {'id':>4} {'label':<12} {'x [m]':>7} {'mass [kg]':>9} {'mu_s':>5} "
                      f"{'mu_d':>5} {'peak [mm]':>10} {'residual [mm]':>13} "
                      f"{'limit [mm]':>15} {'utilisation':>11}")
         for j, p in enumerate(summary["pallets"]):
             util = p["fall_utilisation"]
-            flag = "  AT RISK" if j in summary["pallets_at_risk"] else ""
+            flag = "  AT RISK" if p["id"] in summary["pallets_at_risk"] else ""
             limit = f"{p['limit_neg_m'] * 1e3:.0f} / {p['limit_pos_m'] * 1e3:.0f}"
             util_s = "inf" if util is None or not math.isfinite(util) else f"{util:.2f}"
             lines.append(
-                f"  {j + 1:>3} {int(resp.pallet_level[j]) + 1:>5} {resp.pallet_x[j]:>7.3f} "
+                f"  {p['id']:>4} {p['label']:<12} {resp.pallet_x[j]:>7.3f} "
                 f"{p['mass_kg']:>9.1f} {p['mu_static']:>5.2f} {p['mu_dynamic']:>5.2f} "
                 f"{p['peak_sliding_m'] * 1e3:>10.2f} {p['residual_m'] * 1e3:>13.2f} "
                 f"{limit:>15} {util_s:>11}{flag}")
@@ -411,8 +479,9 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
         lines.append(f"Sliding occurred: {'yes' if summary['sliding_occurred'] else 'no'}"
                      f" ({n_slip} slip events)")
         risk = summary["pallets_at_risk"]
+        labels = {p["id"]: p["label"] for p in summary["pallets"]}
         lines.append("Pallets at risk of falling: "
-                     + (", ".join(f"P{j + 1}" for j in risk) if risk else "none"))
+                     + (", ".join(f"{i} ({labels[i]})" for i in risk) if risk else "none"))
         lines.extend(_simplified_lines(resp, summary["simplified_check"]))
     else:
         lines.append("No pallets on this rack.")
@@ -420,6 +489,32 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
         lines.append("")
         lines.append("Written: " + ", ".join(summary["outputs"]))
     return "\n".join(lines)
+
+
+def _design_lines(design: dict[str, Any] | None) -> list[str]:
+    """Peaks of the design quantities (gravity + seismic, elastic) with the member."""
+    if not design:
+        return []
+    rows = [("interstorey drift ratio", "interstorey_drift_ratio", 1e2, "%"),
+            ("beam end moment", "beam_end_moment_Nm", 1e-3, "kN·m"),
+            ("beam end shear", "beam_end_shear_N", 1e-3, "kN"),
+            ("connector moment", "connector_moment_Nm", 1e-3, "kN·m"),
+            ("connector rotation", "connector_rotation_rad", 1e3, "mrad"),
+            ("upright axial force", "upright_axial_force_N", 1e-3, "kN")]
+    out = ["", "Design quantities (gravity + seismic, elastic; member of the peak)"]
+    for name, key, scale, unit in rows:
+        item = design.get(key) or {}
+        if not item.get("labels"):
+            continue
+        out.append(f"  {name:<38} {item['max_abs'] * scale:>10.3f} {unit:<5} "
+                   f"at {item['max_label']}")
+    nm = design.get("upright_n_m") or {}
+    if nm.get("labels"):
+        k = max(range(len(nm["labels"])), key=lambda i: abs(nm["at_max_abs_N"][i][0]))
+        n_, m_ = nm["at_max_abs_N"][k]
+        out.append(f"  {'upright N with concomitant M':<38} N = {n_ / 1e3:.3f} kN, "
+                   f"M = {m_ / 1e3:.3f} kN·m at {nm['labels'][k]}")
+    return out
 
 
 def _simplified_lines(resp: Any, sc: dict[str, Any]) -> list[str]:
