@@ -18,12 +18,22 @@ from seisrack.fe.modal import modal_analysis
 from seisrack.model import compile_rack, load_rack
 from seisrack.motion import Record, load_builtin_record
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples").glob("*.toml"))
+_DIR = Path(__file__).parent.parent / "examples"
+#: rack files (study files, ``study_*.toml``, are run by tests/test_study_*.py)
+EXAMPLES = sorted(p for p in _DIR.glob("*.toml") if not p.name.startswith("study_"))
+STUDIES = sorted(_DIR.glob("study_*.toml"))
 
 
 def test_examples_exist() -> None:
     names = {p.name for p in EXAMPLES}
-    assert {"paper_rack.toml", "three_level_rack.toml"} <= names
+    assert {"paper_rack.toml", "three_level_rack.toml", "warehouse_rack.toml"} <= names
+
+
+@pytest.mark.parametrize("path", STUDIES, ids=lambda p: p.stem)
+def test_study_examples_load_and_expand(path: Path) -> None:
+    from seisrack.studies import expand, load_study
+
+    assert len(expand(load_study(path))) >= 60  # issue 13: at least 60 runs
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
