@@ -69,10 +69,13 @@ def test_text_report_flags_pallet_at_risk(tmp_path: Path, capsys, rec_csv):
     assert main(["run", str(rack), "--motion", str(rec_csv), "--mu", "0.3"]) == 0
     out = capsys.readouterr().out
     for text in ("beam displacement", "mm", "m/s²", "kN", "kN·m", "base shear",
-                 "Simplified check", "verdict", "Pallets at risk of falling: P2"):
+                 "Simplified check", "verdict", "Pallets at risk of falling: 2 (L1-B1-S2)",
+                 "beam acceleration (absolute, raw)", "beam acceleration (low-pass 20 Hz)",
+                 "interstorey drift ratio", "connector moment", "upright axial force",
+                 "upright N with concomitant M"):
         assert text in out, text
     p2 = next(ln for ln in out.splitlines() if ln.strip().startswith("2 "))
-    assert "AT RISK" in p2
+    assert "AT RISK" in p2 and "L1-B1-S2" in p2
     assert sum("AT RISK" in ln for ln in out.splitlines()) == 1
 
 
@@ -84,8 +87,9 @@ def test_out_folder(tmp_path: Path, capsys, rec_csv):
     (out_dir / "notes.txt").write_text("mine")  # the user's own file: must survive
     (out_dir / "peaks.csv").write_text("stale")  # seisrack's own name: overwritten
     out = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--out", str(out_dir))
-    names = {"timehistory.nc", "peaks.csv", "summary.json", "fig16a_displacement.png",
-             "fig16b_acceleration.png", "fig16c_contact_force.png", "fig16d_sliding.png"}
+    names = {"timehistory.nc", "peaks.csv", "summary.json", "beam_displacement.png",
+             "beam_acceleration.png", "contact_force.png", "pallet_sliding.png",
+             "sliding_heatmap.png"}
     assert {p.name for p in out_dir.iterdir()} == names | {"notes.txt"}
     assert (out_dir / "notes.txt").read_text() == "mine"
     assert (out_dir / "peaks.csv").read_text().startswith("quantity,level,pallet")
@@ -97,7 +101,21 @@ def test_out_folder(tmp_path: Path, capsys, rec_csv):
         assert ds.contact_force.attrs["units"] == "N"
         assert ds.pallet_sliding.dims == ("time", "pallet")
         peak = float(np.abs(ds.beam_displacement).max())
+        # one pallet identity everywhere: ids 1.. and labels as in the JSON
+        assert ds.pallet.values.tolist() == [p["id"] for p in out["pallets"]] == [1, 2, 3, 4]
+        assert ds.pallet_label.values.tolist() == [p["label"] for p in out["pallets"]]
+        filt = float(np.abs(ds.beam_acceleration_filtered).max())
     assert peak == pytest.approx(out["peaks"]["beam_displacement_m"], rel=1e-12)
+    assert filt == pytest.approx(out["peaks"]["beam_acceleration_filtered_m_s2"], rel=1e-12)
+    # a second run into the same folder refuses to overwrite the figures without --force
+    assert main(["run", str(PAPER_RACK), "--motion", str(rec_csv), "--out", str(out_dir),
+                 "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == "--out" and "--force" in err["allowed"]
+    before = (out_dir / "beam_displacement.png").stat().st_mtime_ns
+    _json(capsys, "--motion", str(rec_csv), "--mu", "0.6", "--out", str(out_dir), "--force")
+    assert (out_dir / "beam_displacement.png").stat().st_mtime_ns >= before
+    assert json.loads((out_dir / "summary.json").read_text())["pallets"][0]["mu_static"] == 0.6
 
 
 def test_out_without_plots(tmp_path: Path, capsys, rec_csv):
@@ -247,3 +265,62 @@ def test_basis_save_every_and_rigid_check(capsys, rec_csv):
                                                              rel=5e-3, abs=1e-6)
     assert full["simplified_check"]["alpha_source"].startswith("this run")
     assert red["simplified_check"]["alpha_source"] == "rigid companion run"
+
+
+def test_summary_ids_filtered_acceleration_and_design(capsys, rec_csv):
+    """Issue 14 item 6: 1-based pallet ids and labels, raw and filtered floor accelerations
+    (each labelled), design quantities per member and as peaks."""
+    out = _json(capsys, "--motion", str(rec_csv), "--mu", "0.3", "--accel-filter", "10")
+    assert [p["id"] for p in out["pallets"]] == [1, 2, 3, 4]
+    assert [p["label"] for p in out["pallets"]] == ["L1-B1-S1", "L1-B1-S2", "L1-B2-S1",
+                                                    "L1-B2-S2"]
+    assert all(1 <= i <= 4 for i in out["pallets_at_risk"])
+    pk = out["peaks"]
+    assert pk["acceleration_filter_hz"] == 10.0
+    assert 0 < pk["beam_acceleration_filtered_m_s2"] <= pk["beam_acceleration_m_s2"]
+    design = out["design"]
+    for key in ("interstorey_drift_ratio", "beam_end_moment_Nm", "beam_end_shear_N",
+                "connector_moment_Nm", "connector_rotation_rad", "upright_axial_force_N"):
+        assert design[key]["max_abs"] > 0 and pk[key] == design[key]["max_abs"]
+    assert design["beam_end_moment_Nm"]["labels"] == ["L1-B1-left", "L1-B1-right",
+                                                      "L1-B2-left", "L1-B2-right"]
+    assert design["upright_n_m"]["labels"] == ["U1-base", "U1-L1", "U2-base", "U2-L1",
+                                               "U3-base", "U3-L1"]
+    # gravity: the middle upright carries the most (four 400 kg pallets, two bays)
+    n_grav = design["upright_axial_force_N"]["gravity"]
+    assert n_grav[2] < n_grav[0] < 0
+
+
+def test_warnings_on_implausible_input(tmp_path: Path, capsys):
+    """PGA above 3 g, vertical acceleration below -g, and sliding beyond the rack's length are
+    warnings on stderr (exit 0), not errors."""
+    rec = short_record(duration=2.0)
+    big = tmp_path / "big.csv"
+    write_record_csv(Record(rec.accel * (3.5 * 9.81 / rec.pga), rec.dt), big)
+    vert = tmp_path / "v.csv"
+    write_record_csv(Record(np.full(rec.n, -1.2 * 9.81), rec.dt), vert)
+    assert main(["run", str(PAPER_RACK), "--motion", str(big), "--vertical", str(vert),
+                 "--mu", "0.05", "--json"]) == 0
+    cap = capsys.readouterr()
+    json.loads(cap.out)
+    assert "warning: the record's PGA is" in cap.err and "above 3 g" in cap.err
+    assert "below -g" in cap.err and "lift off" in cap.err
+    assert "error" not in cap.err
+    # a strong long pulse on low friction: sliding beyond the rack's 3.6 m length
+    n = 801
+    pulse = tmp_path / "pulse.csv"
+    write_record_csv(Record(np.r_[np.full(400, 6.0), np.zeros(n - 400)], 0.01), pulse)
+    assert main(["run", str(PAPER_RACK), "--motion", str(pulse), "--mu", "0.01",
+                 "--free-vibration", "20", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert "slid more than the rack's length" in cap.err
+
+
+def test_errors_are_json_under_json(capsys, bad_cases):
+    args, field = bad_cases["mu-negative"]
+    assert main(["run", str(PAPER_RACK), *args, "--json"]) == 2
+    cap = capsys.readouterr()
+    err = json.loads(cap.out)["error"]
+    assert err == {"field": "--mu", "value": -0.1, "allowed": "a friction coefficient >= 0",
+                   "message": err["message"]}
+    assert "--mu" in err["message"] and cap.err == ""
