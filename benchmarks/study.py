@@ -69,9 +69,56 @@ stripes = {levels}
     return path
 
 
+NOOP_PATCH = """# loaded by the benchmark's no-op cases (driver, and Dask workers through preload)
+import seisrack.studies.executors as _ex
+
+
+def _noop(run):
+    row = _ex.failed_row(run, "")
+    row["status"] = "ok"
+    return row
+
+
+_ex.run_one = _noop
+"""
+
+
+def inprocess(cfg: dict) -> dict:
+    """Per-run cost without any executor: ``run_one`` in a loop (real, and 0.1 s records)."""
+    from dataclasses import replace
+
+    from seisrack.motion import Record
+    from seisrack.studies import executors as ex
+    from seisrack.studies.expand import plan
+    from seisrack.studies.spec import load_study
+
+    pl = plan(load_study(cfg["toml"]))
+    out = {}
+    for label, records in (("real", pl.records), ("short", {
+            h: Record(r.accel[:10], r.dt, name=r.name) for h, r in pl.records.items()})):
+        ex._set_context(replace(pl, runs=(), records=records), label)
+        for r in pl.runs[:5]:
+            ex.run_one(r)
+        runs = pl.runs[5:]
+        c0, t0 = time.process_time(), time.perf_counter()
+        for r in runs:
+            ex.run_one(r)
+        out[f"{label}_ms"] = 1e3 * (time.perf_counter() - t0) / len(runs)
+        out[f"{label}_cpu_ms"] = 1e3 * (time.process_time() - c0) / len(runs)
+    out["n"] = len(pl.runs) - 5
+    return out
+
+
 def child(cfg: dict) -> dict:
     """One case in this process: plan, run, read back; times, CPU and peak RSS."""
     from dataclasses import replace
+
+    if cfg.get("inprocess"):
+        return inprocess(cfg)
+    if cfg.get("noop_patch"):  # the local pool forks: its workers inherit the patch
+        import runpy
+
+        runpy.run_path(cfg["noop_patch"])
 
     from seisrack.motion import Record
     from seisrack.studies.expand import plan
@@ -95,6 +142,7 @@ def child(cfg: dict) -> dict:
     c1 = os.times()
     table = read_runs(cfg["out"])
     walls = table.column("wall_time_s").to_pylist()
+    n_pallets = table.column("n_pallets").to_pylist()
     status = table.column("status").to_pylist()
     return {
         "runs": len(pl.runs), "rows": table.num_rows, "ok": status.count("ok"),
@@ -105,23 +153,32 @@ def child(cfg: dict) -> dict:
         + (c1.children_system - c0.children_system),
         "task_s_sum": float(sum(w for w in walls if w == w)),
         "driver_rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-        "parts": s.part_files_written,
+        "parts": s.part_files_written, "noop_rows": n_pallets.count(0),
     }
 
 
 def run_case(tmp: Path, name: str, toml: Path, *, executor: str = "local", workers: int = 2,
-             noop_samples: int | None = None) -> dict:
+             noop_samples: int | None = None, noop: bool = False, inproc: bool = False) -> dict:
     out = tmp / f"out_{name}"
     shutil.rmtree(out, ignore_errors=True)
     cfg = {"toml": str(toml), "out": str(out), "executor": executor, "workers": workers,
-           "noop_samples": noop_samples}
+           "noop_samples": noop_samples, "inprocess": inproc}
+    env = dict(os.environ)
+    if noop:
+        patch = tmp / "noop_patch.py"
+        patch.write_text(NOOP_PATCH)
+        cfg["noop_patch"] = str(patch)
+        env["DASK_DISTRIBUTED__WORKER__PRELOAD"] = json.dumps([str(patch)])
     load0 = os.getloadavg()[0]
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, __file__, "--child", json.dumps(cfg)],
-                          capture_output=True, text=True, cwd=ROOT)
+                          capture_output=True, text=True, cwd=ROOT, env=env)
     if proc.returncode != 0:
         raise RuntimeError(f"case {name} failed:\n{proc.stderr[-3000:]}")
     res = json.loads(proc.stdout.strip().splitlines()[-1])
+    if inproc:
+        print(f"  {name}: {res}", flush=True)
+        return res
     res.update(name=name, executor=executor, workers=workers, load_start=load0,
                load_end=os.getloadavg()[0], process_s=time.perf_counter() - t0)
     shutil.rmtree(out, ignore_errors=True)
@@ -155,13 +212,21 @@ def report(res: dict, meta: dict) -> str:
     big = res.get("big")
     L += ["## Targets side by side", "",
           "| target | measured | met | notes |", "|---|---|---|---|"]
+    ip = res.get("inproc")
+    if ip:
+        L.append(f"| (cost of one run, one process, no executor) | {ip['real_ms']:.1f} ms "
+                 f"(CPU {ip['real_cpu_ms']:.1f} ms); same run on a 0.1 s record: "
+                 f"{ip['short_ms']:.1f} ms | - | {ip['n']} runs of the paper rack, 20 s, "
+                 "mu sampled per run; the 0.1 s case is the fixed cost of a run |")
     if big:
         met = "yes" if big["total_s"] <= 60 else "no"
         L.append(f"| 10,000 runs <= 60 s | {big['total_s']:.1f} s ({big['runs']} runs, "
                  f"{big['ok']} ok) | {met} | plan {big['plan_s']:.1f} s + run "
                  f"{big['run_s']:.1f} s, 2 workers; mean task "
                  f"{_ms(big['task_s_sum'] / big['rows'])}"
-                 f"; load {big['load_start']:.2f} at start |")
+                 f"; workers CPU {_ms(big['children_cpu_s'] / big['runs'])} per run, i.e. "
+                 f"{big['children_cpu_s'] / big['run_s']:.2f} cores busy on average; "
+                 f"load {big['load_start']:.2f} at start |")
     else:
         L.append("| 10,000 runs <= 60 s | not measured | - | |")
     s1, s2 = res.get("scale1"), res.get("scale2")
@@ -169,12 +234,14 @@ def report(res: dict, meta: dict) -> str:
         sp = s1["run_s"] / s2["run_s"]
         L.append(f"| 1 -> 2 workers >= 1.8x | {sp:.2f}x ({s1['run_s']:.2f} s -> "
                  f"{s2['run_s']:.2f} s, {s1['runs']} runs) | {'yes' if sp >= 1.8 else 'no'} | "
-                 f"load {s1['load_start']:.2f} / {s2['load_start']:.2f} at start |")
+                 f"cores obtained (workers CPU / wall): {s1['children_cpu_s'] / s1['run_s']:.2f}"
+                 f" / {s2['children_cpu_s'] / s2['run_s']:.2f}; load {s1['load_start']:.2f} / "
+                 f"{s2['load_start']:.2f} at start |")
     d = res.get("dask_overhead")
     if d:
         L.append(f"| Dask LocalCluster overhead per run <= 5 ms | {_ms(d['dask_slope'])} "
                  f"(local pool {_ms(d['local_slope'])}) | "
-                 f"{'yes' if d['dask_slope'] <= 5e-3 else 'no'} | marginal wall per trivial run, "
+                 f"{'yes' if d['dask_slope'] <= 5e-3 else 'no'} | marginal wall per no-op run, "
                  f"{d['n_small']} vs {d['n_large']} runs, 2 workers |")
     m1, m2 = res.get("mem_small"), res.get("mem_large")
     if m1 and m2:
@@ -199,8 +266,13 @@ def report(res: dict, meta: dict) -> str:
           "pool; Dask's nanny-spawned workers are counted when reaped).", ""]
     if d:
         L += ["## Dask overhead, detail", "",
-              "Trivial runs: the records cut to 10 samples (0.1 s), friction 0.4 only, so a run "
-              "is a scale and a 20-step analysis of a cached model. Marginal cost per run = "
+              "No-op runs: `run_one` replaced (in the driver, inherited by the forked pool, and "
+              "in Dask workers through `distributed.worker.preload`) by a function returning a "
+              "row without analysing, so what is timed is the study machinery: batching, task "
+              "submission, transfer of rows, the driver's buffer and Parquet parts. "
+              f"No-op rows seen in the store: local {d['local_noop_rows']}, Dask "
+              f"{d['dask_noop_rows']} (of {d['n_small'] + d['n_large']} each; a smaller count "
+              "means the patch did not reach the workers). Marginal cost per run = "
               "(wall(large) - wall(small)) / (n_large - n_small), which removes the fixed "
               "start-up of the pool or cluster.", "",
               f"- local pool: {_ms(d['local_slope'])} per run; Dask: {_ms(d['dask_slope'])} "
@@ -222,6 +294,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller studies (a smoke run)")
     ap.add_argument("--skip-big", action="store_true", help="skip the 10,000-run study")
     ap.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "study.md"))
+    ap.add_argument("--raw", default=None, help="also write the raw results as JSON here")
     a = ap.parse_args(argv)
     if a.child:
         print(json.dumps(child(json.loads(a.child))))
@@ -243,6 +316,8 @@ def main(argv: list[str] | None = None) -> int:
         print("warm-up", flush=True)
         run_case(tmp, "warmup", study_toml(tmp, 2, 2, 2))
         cases = res["cases"]
+        # 0. cost of one run without any executor (one process, serial)
+        res["inproc"] = run_case(tmp, "in-process", study_toml(tmp, 2, 5, 20), inproc=True)
         # 4. driver memory: 200 vs 2000 runs (real runs)
         cases.append(run_case(tmp, "mem 200", study_toml(tmp, 2, 5, 20)))
         res["mem_small"] = cases[-1]
@@ -256,18 +331,19 @@ def main(argv: list[str] | None = None) -> int:
         res["scale1"] = cases[-1]
         cases.append(run_case(tmp, "scale w2", s400, workers=2))
         res["scale2"] = cases[-1]
-        # 3. Dask overhead: trivial runs at two sizes, local vs dask; real runs through dask
+        # 3. Dask overhead: no-op runs at two sizes, local vs dask; real runs through dask
         small = study_toml(tmp, 4, 100, 1, lognormal=False)
-        large = study_toml(tmp, 4, 250 if q else 500, 1, lognormal=False)
+        large = study_toml(tmp, 4, 500 if q else 1000, 1, lognormal=False)
         d = {}
         for ex in ("local", "dask"):
-            r1 = run_case(tmp, f"noop small {ex}", small, executor=ex, noop_samples=10)
-            r2 = run_case(tmp, f"noop large {ex}", large, executor=ex, noop_samples=10)
+            r1 = run_case(tmp, f"no-op small {ex}", small, executor=ex, noop=True)
+            r2 = run_case(tmp, f"no-op large {ex}", large, executor=ex, noop=True)
             cases += [r1, r2]
             slope = (r2["run_s"] - r1["run_s"]) / (r2["runs"] - r1["runs"])
             d[f"{ex}_slope"] = slope
             d[f"{ex}_fixed"] = r1["run_s"] - r1["runs"] * slope
             d["n_small"], d["n_large"] = r1["runs"], r2["runs"]
+            d[f"{ex}_noop_rows"] = r1["noop_rows"] + r2["noop_rows"]
         cases.append(run_case(tmp, "real dask", s400, executor="dask"))
         d.update(real_n=cases[-1]["runs"], real_dask=cases[-1]["run_s"],
                  real_local=res["scale2"]["run_s"])
@@ -282,6 +358,8 @@ def main(argv: list[str] | None = None) -> int:
     meta["elapsed_min"] = (time.perf_counter() - t_start) / 60
     text = report(res, meta)
     Path(a.out).write_text(text)
+    if a.raw:
+        Path(a.raw).write_text(json.dumps({"meta": meta, **res}, indent=1))
     print(text)
     return 0
 
