@@ -36,7 +36,8 @@ def test_netcdf_roundtrip(tmp_path: Path, responses):
                                      summary=resp.summary())
     with xr.open_dataset(path) as ds:
         assert dict(ds.sizes) == {"time": resp.t.size, "level": 1, "pallet": 4, "upright": 3,
-                                  "event": len(resp.events)}
+                                  "event": len(resp.events), "storey": 1, "beam_end": 4,
+                                  "connector": 4, "section": 6}
         np.testing.assert_array_equal(ds.beam_displacement.values, resp.beam_displacement)
         np.testing.assert_array_equal(ds.pallet_sliding.values, resp.pallet_sliding)
         np.testing.assert_array_equal(ds.time.values, resp.t)
@@ -132,3 +133,53 @@ def test_unknown_quantity(responses):
 
     with pytest.raises(InputError, match="quantity"):
         rack_plot.plot_rack_histories(responses, "banana")
+
+
+def test_netcdf_ids_labels_design(tmp_path: Path, responses):
+    """Issue 14 item 6: the netCDF pallet coordinate holds the 1-based ids of the JSON, with
+    their labels; the design histories carry their member labels and match the JSON peaks."""
+    resp = responses["μ = 0.30"]
+    s = resp.summary()
+    path = rack_io.write_timehistory(resp, tmp_path / "th.nc", model=paper_model(0.3))
+    with xr.open_dataset(path) as ds:
+        assert ds.pallet.values.tolist() == [p["id"] for p in s["pallets"]]
+        assert ds.pallet_label.values.tolist() == [p["label"] for p in s["pallets"]]
+        assert ds.beam_end_label.values.tolist() == s["design"]["beam_end_moment_Nm"]["labels"]
+        np.testing.assert_allclose(np.abs(ds.beam_end_moment.values).max(axis=0),
+                                   s["design"]["beam_end_moment_Nm"]["peak_abs"], rtol=1e-12)
+        np.testing.assert_allclose(np.abs(ds.upright_axial_force.values).max(axis=0),
+                                   s["design"]["upright_axial_force_N"]["peak_abs"], rtol=1e-12)
+        assert ds.beam_acceleration_filtered.attrs["filter_hz"] == 20.0
+        assert "raw" in ds.beam_acceleration.attrs["long_name"]
+    rows = rack_io.peak_rows(resp)
+    assert any(r["quantity"] == "beam_acceleration_filtered" for r in rows)
+    notes = [r["note"] for r in rows if r["quantity"] == "pallet_sliding"]
+    assert notes[1].startswith("L1-B1-S2")
+
+
+def test_rack_figures_every_level_and_force(tmp_path: Path):
+    """The user's rack: one line per level, a heat map cell per pallet with a colour bar, no
+    overwrite without force."""
+    import matplotlib.pyplot as plt
+
+    from seisrack.errors import InputError
+    from seisrack.model import compile_rack, load_rack
+
+    resp = run_rack(compile_rack(load_rack("examples/three_level_rack.toml")), short_record(2.0))
+    paths = rack_plot.save_rack_figures(resp, tmp_path)
+    assert [p.name for p in paths] == list(rack_plot.RACK_FIGURES)
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in paths)
+    with pytest.raises(InputError, match="--force"):
+        rack_plot.save_rack_figures(resp, tmp_path)
+    assert len(rack_plot.save_rack_figures(resp, tmp_path, force=True)) == 5
+    ax = rack_plot.plot_levels(resp, "beam_displacement")
+    assert [ln.get_label() for ln in ax.get_lines()][:3] == ["level 1", "level 2", "level 3"]
+    plt.close(ax.figure)
+    val, ids, n_slot = rack_plot.sliding_grid(resp)
+    assert val.shape == (3, 6) and n_slot == 2
+    assert ids.tolist() == [[1, 2, 3, 4, 5, 6], [7, 8, 9, 10, 11, 12], [13, 14, 15, 16, 17, 18]]
+    np.testing.assert_allclose(val.ravel(), resp.pallet_peak_sliding())
+    ax = rack_plot.plot_sliding_heatmap(resp)
+    assert len(ax.figure.axes) == 2  # the heat map and its colour bar
+    assert sorted(int(t.get_text()) for t in ax.texts) == list(range(1, 19))
+    plt.close(ax.figure)
