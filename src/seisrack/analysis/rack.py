@@ -54,6 +54,15 @@ class RackResponse:
         n_level) [N·m] largest-magnitude end moment of the upright segments at each connection.
     pallet_sliding: (n_t, m) [m] each pallet relative to its beam; pallet_friction: (n_t, m) [N].
 
+    beam_acceleration_filtered: (n_t, n_level) [m/s²] the same, low-pass filtered at
+        ``acceleration_filter_hz`` (zero-phase Butterworth of the full-rate history; see
+        docs/theory/floor_acceleration.md), or None.
+    pallet_bay: (m,) 0-based bay of each pallet; pallets are identified by 1-based ids in
+        input order and labels ``L{level}-B{bay}-S{slot}`` (:meth:`pallet_labels`).
+    operators: the projected recovery and design operators of the run
+        (:class:`~seisrack.analysis.peaks.RackOperators`), for :meth:`design_peaks` and
+        :func:`~seisrack.analysis.peaks.design_history`.
+
     The histories hold the samples the run kept (``run_rack(save_every=...)``; ``t`` gives
     their times). ``full_peaks`` holds the peaks over every analysis step (always computed);
     the peak methods below read it, so decimating the histories never changes a peak.
