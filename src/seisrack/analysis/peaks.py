@@ -163,7 +163,8 @@ class PeakTracker:
     """
 
     def __init__(self, ops: RackOperators, P: np.ndarray, pallet_level: np.ndarray,  # noqa: N803
-                 ag: np.ndarray, h: float, smooth: bool, keep_accel: bool = False) -> None:
+                 ag: np.ndarray, h: float, smooth: bool, keep_accel: bool = False,
+                 design: bool = True) -> None:
         self.ops, self.P, self.lv = ops, P, pallet_level
         self.ag, self.h, self.smooth = ag, h, smooth
         nl, m = ops.n_level, P.shape[0]
@@ -180,14 +181,16 @@ class PeakTracker:
         self._acc: list[np.ndarray] | None = (
             [] if keep_accel and ag.size * nl <= FULL_RATE_ACCEL_MAX else None)
         self._last_acc: np.ndarray | None = None
-        d = ops.design
+        d = ops.design if design else None
         self.dmax: dict[str, np.ndarray] = {}
         self.dmin: dict[str, np.ndarray] = {}
         if d is not None:
-            for name in DESIGN_QUANTITIES:
-                k = getattr(d, name).shape[1]
-                self.dmax[name] = np.full(k, -np.inf)
-                self.dmin[name] = np.full(k, np.inf)
+            # one (r, Σk) product per chunk instead of one per quantity
+            mats = [getattr(d, name) for name in DESIGN_QUANTITIES]
+            self._dop = np.ascontiguousarray(np.concatenate(mats, axis=1))
+            self._dsplit = np.cumsum([m_.shape[1] for m_ in mats])[:-1]
+            self._dmax_all = np.full(self._dop.shape[1], -np.inf)
+            self._dmin_all = np.full(self._dop.shape[1], np.inf)
             ns = d.axial.shape[1]
             self.n_at_max_n = np.zeros((2, ns))  # rows: N, M at the largest |N|
             self.nm_at_max_m = np.zeros((2, ns))  # rows: N, M at the largest |M|
@@ -210,7 +213,7 @@ class PeakTracker:
         if self._acc is not None:  # chunks share their boundary sample: keep it once
             self._acc.append(a_abs[:-1].copy())
             self._last_acc = a_abs[-1].copy()
-        if o.design is not None:
+        if hasattr(self, "_dop"):
             self._design(c.q)
         force = np.zeros((c.t.shape[0], o.n_level))
         np.add.at(force.T, self.lv, c.friction.T)
@@ -227,13 +230,10 @@ class PeakTracker:
 
     def _design(self, q: np.ndarray) -> None:
         d = self.ops.design
-        vals = {}
-        for name in DESIGN_QUANTITIES:
-            x = q @ getattr(d, name)
-            vals[name] = x
-            if x.shape[1]:
-                self.dmax[name] = np.maximum(self.dmax[name], x.max(axis=0))
-                self.dmin[name] = np.minimum(self.dmin[name], x.min(axis=0))
+        x_all = q @ self._dop
+        np.maximum(self._dmax_all, x_all.max(axis=0, initial=-np.inf), out=self._dmax_all)
+        np.minimum(self._dmin_all, x_all.min(axis=0, initial=np.inf), out=self._dmin_all)
+        vals = dict(zip(DESIGN_QUANTITIES, np.split(x_all, self._dsplit, axis=1), strict=True))
         n = vals["axial"] + d.static["axial"]
         m = vals["section_moment"] + d.static["section_moment"]
         if n.shape[1]:
@@ -253,7 +253,11 @@ class PeakTracker:
 
     def result(self) -> dict[str, np.ndarray | float]:
         out = self._result()
-        if self.dmax:
+        if hasattr(self, "_dop"):
+            for name, hi, lo in zip(DESIGN_QUANTITIES,
+                                    np.split(self._dmax_all, self._dsplit),
+                                    np.split(self._dmin_all, self._dsplit), strict=True):
+                self.dmax[name], self.dmin[name] = hi, lo
             out["design_max"] = self.dmax
             out["design_min"] = self.dmin
             out["upright_nm_at_max_n"] = self.n_at_max_n

@@ -423,8 +423,9 @@ def run_rack(
     ops = rack_operators(model, bas.phi)
     # the smoothing of Newmark's period-2h acceleration residue is decided after the run;
     # track both and keep the one that applies
-    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s, keep_accel=True)
-                for s in (False, True)}
+    # the design quantities do not depend on the smoothing: the first tracker has them
+    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s, keep_accel=True,
+                               design=not s) for s in (False, True)}
 
     def on_chunk(c) -> None:  # noqa: ANN001
         for t in trackers.values():
@@ -434,7 +435,7 @@ def run_rack(
                     save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
                     max_memory=max_memory)
     tracker = trackers[hist.method == "newmark"]
-    peaks = tracker.result()
+    peaks = {**trackers[False].result(), **tracker.result()}
     acc_full = tracker.level_acceleration()
     del trackers, tracker
     acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
@@ -442,7 +443,7 @@ def run_rack(
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
     rigid_peak = None
     if rigid_companion and model.n_pallets:
-        rig = PeakTracker(ops, P, pallet_level, ag, h, smooth=False)
+        rig = PeakTracker(ops, P, pallet_level, ag, h, smooth=False, design=False)
         rigid_sl = Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU)
         common["method"] = "exact" if hist.method == "exact" else method
         simulate(*mats, rigid_sl, **common, basis=bas, save_every=None, on_chunk=rig,
