@@ -437,7 +437,6 @@ def run_rack(
     tracker = trackers[hist.method == "newmark"]
     peaks = {**trackers[False].result(), **tracker.result()}
     acc_full = tracker.level_acceleration()
-    del trackers, tracker
     acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
     peaks["beam_acceleration_filtered"] = (
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
