@@ -102,7 +102,8 @@ def test_fall_check_flags_pallet_beyond_its_limit():
     assert util[0] == pytest.approx(peak[0] / 0.005, rel=1e-9) and util[0] > 1
     assert np.all(util[1:] < 1)
     s = resp.summary()
-    assert s["pallets_at_risk"] == [0] and s["pallets"][0]["fall_utilisation"] > 1
+    # the summary numbers pallets from 1 (issue 14); the library method is 0-based
+    assert s["pallets_at_risk"] == [1] and s["pallets"][0]["fall_utilisation"] > 1
 
 
 def test_fall_check_uses_the_side_it_slid_towards():

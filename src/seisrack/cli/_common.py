@@ -3,31 +3,10 @@
 from __future__ import annotations
 
 import json
-import math
 import sys
-from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-
-def _to_jsonable(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _to_jsonable(obj.tolist())
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating | float):
-        val = float(obj)
-        return val if math.isfinite(val) else None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
+from seisrack.jsonable import to_jsonable as _to_jsonable
 
 
 def print_json(obj: Any) -> None:

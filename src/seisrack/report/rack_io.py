@@ -326,7 +326,7 @@ def write_peaks_csv(resp: RackResponse, path: str | Path) -> Path:
 
 # ---------------------------------------------------------------------------------- JSON
 def _jsonable(obj: Any) -> Any:
-    from seisrack.cli._common import _to_jsonable
+    from seisrack.jsonable import to_jsonable as _to_jsonable
 
     return _to_jsonable(obj)
 
