@@ -86,9 +86,15 @@ def runs_as_arrays(table) -> dict[str, np.ndarray]:  # noqa: ANN001
     for c in _STR:
         vals = table.column(c).to_pylist() if c in names else [None] * n
         out[c] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
+    import pyarrow as pa
+
     for c in _NUM:
-        vals = table.column(c).to_pylist() if c in names else [None] * n
-        out[c] = np.array([math.nan if v is None else float(v) for v in vals], dtype=float)
+        if c not in names:
+            out[c] = np.full(n, math.nan)
+            continue
+        # float64 keeps nulls as NaN; bool and int64 columns are cast first
+        col = table.column(c).cast(pa.float64())
+        out[c] = np.asarray(col.to_numpy(zero_copy_only=False), dtype=float)
     return out
 
 
