@@ -66,7 +66,11 @@ def test_unknown_key_subprocess(tmp_path: Path):
     f = tmp_path / "bad.toml"
     f.write_text(PAPER_RACK.read_text().replace("mu_dynamic = 0.6\n", "mu_dynamik = 0.6\n", 1))
     proc = _run("modal", str(f), "--json")
-    assert proc.returncode != 0 and proc.stdout == ""
+    # under --json the error is one JSON object on stdout (issue 14)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr + proc.stdout
+    assert json.loads(proc.stdout)["error"]["field"] == "pallets[0].mu_dynamic"  # missing key
+    proc = _run("modal", str(f))
+    assert proc.returncode == 2 and proc.stdout == ""
     assert "Traceback" not in proc.stderr and "pallets[0].mu_dynamic" in proc.stderr
 
 

@@ -58,15 +58,19 @@ def test_sdof_bad_input(capsys, args, field):
         base[k] = v
     argv = ["sdof", "--json"] + [x for kv in base.items() for x in kv]
     rc, out, err = _run(capsys, argv)
-    assert rc == 2 and out == ""
-    assert f"'{field}'" in err and "Traceback" not in err
+    # under --json the error is one JSON object on stdout (issue 14), never a traceback
+    assert rc == 2 and json.loads(out)["error"]["field"] == field
+    assert "Traceback" not in err and "Traceback" not in out
+    rc, out, err = _run(capsys, [a for a in argv if a != "--json"])
+    assert rc == 2 and out == "" and f"'{field}'" in err and "Traceback" not in err
 
 
 def test_sdof_bad_input_subprocess_no_traceback():
     p = subprocess.run([sys.executable, "-m", "seisrack", "sdof", "--alpha", "-1", "--mu", "0.3",
                         "--frequency", "1", "--duration", "1", "--json"],
                        capture_output=True, text=True)
-    assert p.returncode == 2 and "Traceback" not in p.stderr and "alpha" in p.stderr
+    assert p.returncode == 2 and "Traceback" not in p.stderr + p.stdout
+    assert json.loads(p.stdout)["error"]["field"] == "alpha"
 
 
 def test_validate_json_shape(capsys, monkeypatch):
@@ -78,6 +82,7 @@ def test_validate_json_shape(capsys, monkeypatch):
         calls["dt"] = dt
         entry = {"max_abs_displacement_m": [0.1], "max_abs_sliding_m": 0.0, "sliding_phases": 0,
                  "final_sliding_m": 0.0, "source": "reference"}
+        entry["reference"] = dict(entry)
         return {"example2": {k: dict(entry) for k in ("1.0", "0.5", "0.3")},
                 "example3": {k: dict(entry) for k in ("10.0", "0.5", "0.3", "0.1")}}
 
@@ -90,5 +95,5 @@ def test_validate_json_shape(capsys, monkeypatch):
 
 
 def test_validate_bad_dt(capsys):
-    rc, _, err = _run(capsys, ["validate", "--json", "--dt", "-1"])
-    assert rc == 2 and "'dt'" in err
+    rc, out, _ = _run(capsys, ["validate", "--json", "--dt", "-1"])
+    assert rc == 2 and json.loads(out)["error"]["field"] == "dt"
