@@ -61,6 +61,14 @@ def test_all_or_nothing_and_empty_cases():
     assert sep.theta == pytest.approx(math.sqrt(2.0))
     quasi = fr.fit_fragility([1, 2, 4], [10, 10, 10], [0, 4, 10])
     assert quasi.status == "separated" and quasi.theta == pytest.approx(2.0)
+    # one mixed stripe at the top (or bottom) of all-nothing (all-exceed) stripes: a step there
+    top = fr.fit_fragility([1, 2, 4], [24, 24, 24], [0, 0, 11])
+    assert top.status == "separated" and top.theta == pytest.approx(4.0)
+    assert top.loglik == pytest.approx(stats.binom.logpmf(11, 24, 11 / 24))
+    bottom = fr.fit_fragility([1, 2, 4], [24, 24, 24], [5, 24, 24])
+    assert bottom.status == "separated" and bottom.theta == pytest.approx(1.0)
+    # ... but not when the all-nothing stripe lies above the mixed one (non-monotone)
+    assert fr.fit_fragility([1, 2, 4], [24, 24, 24], [0, 11, 0]).status != "separated"
     assert fr.fit_fragility([1, 2], [5, 5], [0, 0]).status == "no_exceedance"
     assert fr.fit_fragility([1, 2], [5, 5], [5, 5]).status == "all_exceed"
     assert fr.fit_fragility([1, 2], [0, 0], [0, 0]).status == "no_data"

@@ -63,7 +63,7 @@ def plot_fragility(
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlim(left=0.0)
     if label:
-        ax.legend(loc="lower right", fontsize="small")
+        ax.legend(loc="best", fontsize="small")
     return ax
 
 

@@ -151,20 +151,24 @@ def _start(lx: np.ndarray, n: np.ndarray, k: np.ndarray) -> tuple[float, float]:
 def _separated(x, n, k) -> float | None:
     """Where the likelihood supremum is a step (beta -> 0), its location, else None.
 
-    That happens when the all-nothing stripes lie below the all-exceed stripes and any mixed
-    stripes share one IM between them: the step then sits at that IM (or, with no mixed stripe,
-    at the geometric mean of the two IMs around the jump).
+    That happens when the stripes with no exceedance all lie below the stripes where every run
+    exceeds, and the mixed stripes (if any) share one IM between the two groups: the step then
+    sits at that IM (theta -> x_mid with ln(x_mid/theta)/beta = Phi^-1(z/n) fixed), or, with no
+    mixed stripe, anywhere in the gap (the geometric mean of the two IMs around it is returned).
+    One of the two groups may be empty when there is a mixed stripe.
     """
     frac = k / n
     zero, one = x[frac == 0], x[frac == 1]
     mid = np.unique(x[(frac > 0) & (frac < 1)])
-    if mid.size > 1 or zero.size == 0 or one.size == 0:
+    if mid.size > 1:
         return None
     if mid.size == 1:
-        if zero.max() < mid[0] < one.min():
-            return float(mid[0])
-        return None
-    if zero.max() < one.min():
+        if zero.size + one.size == 0:
+            return None  # one informative stripe only: a ridge, not a step
+        below = zero.size == 0 or zero.max() < mid[0]
+        above = one.size == 0 or one.min() > mid[0]
+        return float(mid[0]) if below and above else None
+    if zero.size and one.size and zero.max() < one.min():
         return math.sqrt(float(zero.max()) * float(one.min()))
     return None
 

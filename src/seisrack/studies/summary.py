@@ -327,7 +327,7 @@ def format_summary(s: dict[str, Any]) -> str:
     for g in s["groups"]:
         lines.append(f"\nrack {g['rack']}, IM = {g['im_measure']} [m/s²]")
         if "stripes" in g:
-            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  falls")
+            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  falls (mean)")
             for st in g["stripes"]["stripes"]:
                 pk = st["peaks"]["peak_sliding_max_m"]
                 nf = st["peaks"]["n_fall"]
@@ -342,6 +342,21 @@ def format_summary(s: dict[str, Any]) -> str:
         lines.append(f"  {f['analysis']:7s} {f['name']:22s} theta {_fmt(f['theta']):>7} "
                      f"[{_fmt(f['theta_lo'])}, {_fmt(f['theta_hi'])}]  beta {_fmt(f['beta']):>6} "
                      f"[{_fmt(f['beta_lo'])}, {_fmt(f['beta_hi'])}]  {f['status']}")
+    notes = {
+        "separated": "separated: the stripes jump from no exceedance to exceedance without "
+                     "enough stripes in between; the MLE is a step (beta = 0). Add stripes "
+                     "around theta to estimate the dispersion.",
+        "underdetermined": "underdetermined: one stripe carries all the information; theta "
+                           "and beta cannot both be estimated.",
+        "no_exceedance": "no_exceedance: no run reached the state; raise the stripes.",
+        "all_exceed": "all_exceed: every run reached the state; lower the stripes.",
+        "failed": "failed: the likelihood has no maximum in range (e.g. fractions decreasing "
+                  "with IM).",
+        "ida_censored": "ida_censored: some IDA curves never reached the state and were left "
+                        "out (theta is biased low).",
+    }
+    seen = [st for st in notes if any(f["status"] == st for f in s["fragility"])]
+    lines += [f"  note: {notes[st]}" for st in seen]
     if "files" in s:
         lines.append("\nwritten: " + ", ".join(s["files"].values()))
     return "\n".join(lines)
