@@ -124,12 +124,12 @@ def _model(run):  # noqa: ANN001, ANN202
 def _basis(model):  # noqa: ANN001, ANN202
     """The basis ``run_rack(basis="auto")`` would build (or "auto": built by every run)."""
     try:
-        from seisrack.analysis.rack import _basis_for
+        from seisrack.analysis.rack import rack_basis
         from seisrack.dynamics.sliders import Sliders
 
         sliders = Sliders(model.pallet_dof, model.pallet_mass, model.pallet_mu_static,
                           model.pallet_mu_dynamic)
-        return _basis_for(model, sliders, "auto", None)
+        return rack_basis(model, sliders, "auto", None)
     except (ImportError, TypeError):  # pragma: no cover - an engine without this helper
         return "auto"
 
