@@ -290,9 +290,14 @@ def report(res: dict, meta: dict) -> str:
               "run: both cases obtained about one core (`cores obtained` in the table above). "
               "The workers' CPU for the same 400 runs is "
               f"{res['scale1']['children_cpu_s']:.1f} s on 1 worker and "
-              f"{res['scale2']['children_cpu_s']:.1f} s on 2: the work hardly grows with the "
-              "number of workers, so on free cores the speed-up would be bounded by that "
-              "growth and the pool start-up; it remains to be measured on an idle machine.", ""]
+              f"{res['scale2']['children_cpu_s']:.1f} s on 2 (the CPU per run grows by "
+              f"{100 * (s2['children_cpu_s'] / s1['children_cpu_s'] - 1):.0f}"
+              " % with two workers sharing the machine), so on free cores the speed-up would "
+              "be at most about "
+              f"2 x {res['scale1']['children_cpu_s']:.1f} / "
+              f"{res['scale2']['children_cpu_s']:.1f} = "
+              f"{2 * res['scale1']['children_cpu_s'] / res['scale2']['children_cpu_s']:.2f}x "
+              "less the pool start-up; it remains to be measured on an idle machine.", ""]
     if d:
         L += ["## Dask overhead, detail", "",
               "No-op runs: `run_one` replaced (in the driver, inherited by the forked pool, and "

@@ -214,3 +214,14 @@ def test_summary_main_bad_input(tmp_path, capsys, case):
     assert code == 2
     assert err.startswith("error:") and "Traceback" not in err
     assert ("d_slide" in err) if case == "bad_d" else (str(target) in err)
+
+
+def test_local_reader_dedups_and_sorts(tmp_path):
+    """The fallback reader (used when the store module is absent) keeps one row per run_id."""
+    from seisrack.studies.summary import _read_runs_local
+
+    rows = [_row(i, peak_sliding_max_m=0.01 * i) for i in (3, 1, 2)]
+    _write(tmp_path, rows + [dict(rows[1])], parts=2)
+    table = _read_runs_local(tmp_path)
+    assert table.column("run_id").to_pylist() == ["r00001", "r00002", "r00003"]
+    assert _read_runs_local(tmp_path / "nowhere").num_rows == 0
