@@ -267,7 +267,8 @@ def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None
     if plots:
         files.update(_figures(folder, summary, boots))
     summary["files"] = files
-    (folder / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False))
+    (folder / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1,
+                                                    allow_nan=False))
 
 
 def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
@@ -312,6 +313,19 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
     return files
+
+
+def _jsonable(obj: Any) -> Any:
+    """Non-finite floats -> None (JSON has no NaN), numpy scalars -> Python, recursively."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.generic):
+        obj = obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
 
 
 def _fmt(x: Any, spec: str = ".3g") -> str:
@@ -392,7 +406,7 @@ def summary_main(argv: list[str]) -> int:
         print(f"error: could not read the study in {a.dir}: {exc}", file=sys.stderr)
         return 2
     if a.json:
-        print(json.dumps(s, allow_nan=False))
+        print(json.dumps(_jsonable(s), allow_nan=False))
     else:
         print(format_summary(s))
     return 0
