@@ -9,13 +9,19 @@ moments, and each pallet's sliding against its fall limit.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 
-from seisrack.analysis.peaks import PeakTracker, connection_moment, rack_operators
+from seisrack.analysis.peaks import (
+    PeakTracker,
+    RackOperators,
+    connection_moment,
+    rack_operators,
+)
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
     ACCEL_FILTER_ORDER,
@@ -24,7 +30,7 @@ from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack A
 )
 from seisrack.dynamics import Sliders, TimeHistory, simulate
 from seisrack.dynamics.basis import Basis
-from seisrack.errors import InputError
+from seisrack.errors import InputError, SolverError
 from seisrack.model.frame_model import FrameModel
 from seisrack.motion.records import Record
 
@@ -78,6 +84,7 @@ def run_rack(
     track_energy: bool = True,
     max_memory: float | None = None,
     accel_filter_hz: float = ACCEL_FILTER_HZ,
+    operators: RackOperators | None = None,
 ) -> RackResponse:
     """Time history of ``model`` under the horizontal ground acceleration ``record``.
 
@@ -100,6 +107,8 @@ def run_rack(
     accel_filter_hz: [Hz] cut-off of the zero-phase low-pass filter of the reported floor
         accelerations (``beam_acceleration_filtered``; the raw ``beam_acceleration`` is kept),
         applied to the full-rate level accelerations whatever ``save_every`` is.
+    operators: ``rack_operators(model, basis.phi)`` computed once by a caller that runs the
+        same model many times (a study), with ``basis`` given too; default: built here.
     """
     if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
             and accel_filter_hz > 0):
@@ -146,22 +155,26 @@ def run_rack(
     level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
     pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
     P = bas.phi[model.pallet_dof, :]  # (m, r) support of each pallet
-    ops = rack_operators(model, bas.phi)
-    # the smoothing of Newmark's period-2h acceleration residue is decided after the run;
-    # track both and keep the one that applies
-    # the design quantities do not depend on the smoothing: the first tracker has them
-    trackers = {s: PeakTracker(ops, P, pallet_level, ag, h, smooth=s, keep_accel=True,
-                               design=not s) for s in (False, True)}
-
-    def on_chunk(c) -> None:  # noqa: ANN001
-        for t in trackers.values():
-            t(c)
-
+    if operators is None:
+        ops = rack_operators(model, bas.phi)
+    elif operators.level.shape[0] != bas.phi.shape[1]:
+        raise InputError("operators", f"operators for a basis of {operators.level.shape[0]}",
+                         f"rack_operators(model, basis.phi) of this basis ({bas.size} vectors)")
+    else:
+        ops = operators
+    # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
+    # engine takes Newmark for a rack exactly when asked or when the damping has a mass term
+    newmark = method == "newmark" or (
+        method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
+    tracker = PeakTracker(ops, P, pallet_level, ag, h, smooth=newmark, keep_accel=True,
+                          design=True)
     hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
-                    save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
+                    save_every=save_every, on_chunk=tracker, track_energy=track_energy,
                     max_memory=max_memory)
-    tracker = trackers[hist.method == "newmark"]
-    peaks = {**trackers[False].result(), **tracker.result()}
+    if (hist.method == "newmark") != newmark:  # pragma: no cover - guards the rule above
+        raise SolverError(f"run_rack expected the {'newmark' if newmark else 'exact'} "
+                          f"method but the engine used {hist.method}")
+    peaks = tracker.result()
     acc_full = tracker.level_acceleration()
     acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
     peaks["beam_acceleration_filtered"] = (
@@ -187,14 +200,22 @@ def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER)
     time; the magnitude response is the square of the order-``order`` filter's, -6 dB at fc).
     A cut-off at or above the Nyquist frequency returns ``a`` unchanged.
     """
-    from scipy.signal import butter, sosfiltfilt
+    from scipy.signal import sosfiltfilt
 
     a = np.asarray(a, dtype=float)
     if fc >= 0.5 / h or a.shape[0] < 2:
         return a.copy()
-    sos = butter(order, fc, btype="low", fs=1.0 / h, output="sos")
+    sos = _butter_sos(int(order), float(fc), float(h)).copy()  # scipy wants it writable
     pad = min(3 * (2 * sos.shape[0] + 1), a.shape[0] - 1)
     return sosfiltfilt(sos, a, axis=0, padlen=pad)
+
+
+@functools.lru_cache(maxsize=32)
+def _butter_sos(order: int, fc: float, h: float) -> np.ndarray:
+    """Butterworth second-order sections (designed once per (order, fc, h): ~1 ms each)."""
+    from scipy.signal import butter
+
+    return butter(order, fc, btype="low", fs=1.0 / h, output="sos")
 
 
 def pallet_bays(model: FrameModel) -> np.ndarray:

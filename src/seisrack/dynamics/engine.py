@@ -17,7 +17,7 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._store import Buffers as _Buffers
@@ -237,7 +237,7 @@ def simulate(
     start = 0
     # The kernel's algebra is small (r x r): a threaded BLAS only adds spinning threads, which
     # made runs 5-10x slower on a loaded 2-core machine (measured on the warehouse rack).
-    limiter = threadpool_limits(limits=1, user_api="blas")
+    limiter = _blas_controller().limit(limits=1, user_api="blas")
     try:
         while start < n_steps:
             stop = min(start + chunk, n_steps)
@@ -319,6 +319,17 @@ def simulate(
         basis=bas.describe(),
         sample_index=kidx,
     )
+
+
+_CONTROLLER: list[ThreadpoolController] = []
+
+
+def _blas_controller() -> ThreadpoolController:
+    """One inspection of the loaded BLAS libraries per process (it reads /proc/self/maps:
+    about 1 ms, too much to repeat on every run of a study)."""
+    if not _CONTROLLER:
+        _CONTROLLER.append(ThreadpoolController())
+    return _CONTROLLER[0]
 
 
 def _choose_basis(basis, M, K, sliders, r, rv, F) -> Basis:  # noqa: ANN001, N803

@@ -46,7 +46,7 @@ def plot_fragility(
     im, fraction: (m,) stripe intensity [IM units] and fraction of runs exceeding [-];
     band: (lo, hi) on ``grid`` (pointwise bootstrap percentiles).
     """
-    from seisrack.studies.fragility import fragility_curve
+    from seisrack.lognormal import fragility_curve
 
     ax = _axes(ax)
     im = np.asarray(im, dtype=float)

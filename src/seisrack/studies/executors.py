@@ -110,15 +110,25 @@ def _model(run):  # noqa: ANN001, ANN202
 
         rack = apply_pattern(_CTX.racks[run.rack_hash], _CTX.patterns[key])
         model = compile_rack(rack)
-        hit = (model, rack, _basis(model))
+        basis = _basis(model)
+        hit = (model, rack, basis, _operators(model, basis))
         if len(_MODELS) >= _CACHE_MAX:
             _MODELS.clear()
         _MODELS[key] = hit
-    model, rack, basis = hit
+    model, rack, basis, ops = hit
     n = model.pallet_mass.shape[0]
     model = replace(model, pallet_mu_static=np.full(n, float(run.mu_static)),
                     pallet_mu_dynamic=np.full(n, float(run.mu_dynamic)))
-    return model, rack, basis
+    return model, rack, basis, ops
+
+
+def _operators(model, basis):  # noqa: ANN001, ANN202
+    """The rack operators projected on ``basis`` (friction does not enter them), or None."""
+    if isinstance(basis, str):
+        return None
+    from seisrack.analysis.peaks import rack_operators
+
+    return rack_operators(model, basis.phi)
 
 
 def _basis(model):  # noqa: ANN001, ANN202
@@ -171,9 +181,9 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
     t0 = time.perf_counter()
     try:
         _hook(run)
-        model, rack, basis = _model(run)
+        model, rack, basis, ops = _model(run)
         res = run_rack(model, _scaled(run), dt=_CTX.dt, save_every=None, track_energy=False,
-                       throw=False, basis=basis)
+                       throw=False, basis=basis, operators=ops)
         if res.status != "ok":
             return failed_row(run, f"solver status: {res.status}", time.perf_counter() - t0)
         fp = res.full_peaks

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import optimize, special
 
 from seisrack.errors import InputError
+from seisrack.lognormal import fragility_curve
 
 __all__ = [
     "FragilityFit",
@@ -272,16 +273,6 @@ def fit_fragility(im, n_total, n_exceed) -> FragilityFit:
     else:
         status = "ok"
     return FragilityFit(theta, beta, loglik, m, status, n_runs, se_u, se_b, "mle")
-
-
-def fragility_curve(x, theta: float, beta: float) -> np.ndarray:
-    """Phi(ln(x/theta)/beta) at intensities x; beta = 0 gives the step at theta."""
-    x = np.asarray(x, dtype=float)
-    if not (theta > 0) or not math.isfinite(theta) or not (beta >= 0):
-        return np.full(x.shape, np.nan)
-    if beta == 0:
-        return (x >= theta).astype(float)
-    return special.ndtr(np.log(x / theta) / beta)
 
 
 def bootstrap_fragility(im, n_total, n_exceed, n_boot: int = 200, seed: int = 0
