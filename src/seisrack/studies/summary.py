@@ -198,12 +198,14 @@ def _ida(r, idx, states, n_boot, seed) -> dict[str, Any]:
 
 
 def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: float | None = None,
-              n_boot: int = 200, seed: int = 0, write: bool = True, plots: bool = True
-              ) -> dict[str, Any]:
+              n_boot: int = 200, seed: int = 0, write: bool = True, plots: bool = True,
+              boots: list | None = None) -> dict[str, Any]:
     """Summary of the study stored in ``out_dir`` (see the module docstring).
 
     d_slide: sliding thresholds [m] (a float or a sequence); shear_capacity: base shear [N] for
-    the ``base_shear>V`` damage state (omitted when None); n_boot: bootstrap resamples per fit.
+    the ``base_shear>V`` damage state (omitted when None); n_boot: bootstrap resamples per fit;
+    boots: a list that receives ``(rack, im_measure, kind, state, (thetas, betas))`` per fit
+    (the bootstrap samples, for the bands of the HTML report).
     Returns the dict written to ``summary.json``.
     """
     out = Path(out_dir)
@@ -250,6 +252,8 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
                 summary["fragility"].append({"name": name, "rack": rack, "im_measure": meas,
                                              "analysis": kind, **row})
         summary["groups"].append(g)
+    if boots is not None:
+        boots.extend(boot_store)
     if write:
         _write(out / "summary", summary, plots=plots, boots=boot_store)
     return summary
@@ -377,7 +381,8 @@ def format_summary(s: dict[str, Any]) -> str:
 
 
 def summary_main(argv: list[str]) -> int:
-    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]``."""
+    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]
+    [--report FILE.html [--force]]``."""
     p = argparse.ArgumentParser(prog="seisrack study summary",
                                 description="Summarise a study: counts, EC8 means, fragility.")
     p.add_argument("dir", help="the study output folder (--out of `seisrack study`)")
@@ -389,6 +394,9 @@ def summary_main(argv: list[str]) -> int:
     p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--report", metavar="FILE.html", default=None,
+                   help="also write the study's self-contained HTML report")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --report")
     try:
         a = p.parse_args(argv)
     except SystemExit as exc:  # argparse already printed its usage message
@@ -396,9 +404,20 @@ def summary_main(argv: list[str]) -> int:
     if a.boot < 0:
         print("error: --boot must be >= 0", file=sys.stderr)
         return 2
+    boots: list = []
     try:
+        if a.report:  # refuse an existing report before any work
+            from seisrack.report.html import check_report_path
+
+            check_report_path(a.report, a.force, field="--report")
         s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
-                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots)
+                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots)
+        if a.report:
+            from seisrack.report.html import write_study_report
+
+            html = write_study_report(a.report, _jsonable(s), out_dir=a.dir, boots=boots,
+                                      seed=a.seed, force=a.force)
+            s.setdefault("files", {})["report_html"] = str(html)
     except SeisrackError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -15,8 +15,9 @@ from typing import Any
 
 from seisrack.errors import InputError
 from seisrack.report.html.page import build_html
+from seisrack.report.html.study_page import build_study_html, write_study_report
 
-__all__ = ["build_html", "write_html_report"]
+__all__ = ["build_html", "build_study_html", "write_html_report", "write_study_report"]
 
 
 def check_report_path(path: str | os.PathLike[str], force: bool = False,
