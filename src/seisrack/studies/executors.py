@@ -7,6 +7,12 @@ CPU on a loaded machine), and caches compiled models and scaled records per proc
 fails (a :class:`~seisrack.errors.SeisrackError`, a solver status other than "ok", or any other
 exception) is a row with ``status = "failed"`` and the reason; it never stops the batch.
 
+IDA with a stop rule (``plan.ida_stop``): a batch holds whole IDA curves (the driver's
+batching keeps them together); :func:`run_batch` runs each curve's levels in increasing order
+and, from the first level where the rule holds, returns "skipped" rows (:func:`skipped_row`)
+for the levels above instead of running them. The rows depend on the curve only, never on how
+curves are batched, so they are the same on any executor and number of workers.
+
 The executors are strategies with one method, ``run(batches)``, an iterator over the rows of
 each finished batch, in completion order:
 
@@ -65,7 +71,32 @@ def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
 
 def run_batch(batch: list) -> list[dict[str, Any]]:
     """Rows of the runs of ``batch`` (worker side; the context was set by the initializer)."""
-    return [run_one(r) for r in batch]
+    rule = getattr(_CTX, "ida_stop", None)
+    if rule is None:
+        return [run_one(r) for r in batch]
+    rows = []
+    for curve in split_curves(batch):
+        stop = None  # the run at which the rule held
+        for r in sorted(curve, key=lambda r: r.im_target):
+            if stop is not None:
+                rows.append(skipped_row(r, stop.im_target, rule))
+                continue
+            row = run_one(r)
+            rows.append(row)
+            if rule.holds(row):
+                stop = r
+    return rows
+
+
+def split_curves(runs: list) -> list[list]:
+    """``runs`` grouped by IDA curve (:func:`~seisrack.studies.expand.curve_key`), in order of
+    first appearance."""
+    from seisrack.studies.expand import curve_key
+
+    groups: dict = {}
+    for r in runs:
+        groups.setdefault(curve_key(r), []).append(r)
+    return list(groups.values())
 
 
 def run_batch_ctx(ctx: Any, ctx_id: str, batch: list) -> list[dict[str, Any]]:
@@ -174,6 +205,12 @@ def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # n
             "upright_moment_connection_Nm": nan, "wall_time_s": wall}
 
 
+def skipped_row(run, stop_im: float, rule) -> dict[str, Any]:  # noqa: ANN001
+    """The row of an IDA level above the stop level ``stop_im`` [m/s²]: not run."""
+    return {**failed_row(run, f"IDA stopped at IM = {stop_im!r} m/s² by rule {rule.label}",
+                         0.0), "status": "skipped"}
+
+
 def run_one(run) -> dict[str, Any]:  # noqa: ANN001
     """Scale the record, compile the rack with the run's friction, run it, extract the row."""
     from seisrack.analysis import run_rack
@@ -254,18 +291,20 @@ class LocalExecutor:
                 log.warning("a worker process died: resubmitting %d batch(es)", len(broken))
                 yield from self._requeue(broken, pending)
 
-    @staticmethod
-    def _requeue(broken: list, pending: deque) -> Iterator[list[dict[str, Any]]]:
+    def _requeue(self, broken: list, pending: deque) -> Iterator[list[dict[str, Any]]]:
+        # the unit of a split: one run, or one IDA curve with a stop rule (run in order)
         for b, a in broken:
+            units = split_curves(b) if self.ctx.ida_stop is not None else [[r] for r in b]
             if a == 0:
                 pending.append((b, 1))
-            elif len(b) > 1:
-                pending.extend(([r], 2) for r in b)
+            elif len(units) > 1:
+                pending.extend((u, 2) for u in units)
             elif a < 3:
                 pending.append((b, a + 1))
             else:
-                yield [failed_row(b[0], "the worker process died (killed by a signal?) "
-                                        "three times on this run")]
+                yield [failed_row(r, "the worker process died (killed by a signal?) three "
+                                     "times on this run" + (" or its IDA curve" if len(b) > 1
+                                                            else "")) for r in b]
 
 
 class DaskExecutor:

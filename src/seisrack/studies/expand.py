@@ -12,6 +12,10 @@ so a sample does not depend on the order of expansion nor on which runs are alre
 same (rack, record, occupancy, sample index) sees the same friction at every intensity level
 (common random numbers: an IDA curve follows one realisation, and stripes differ only by
 intensity).
+
+IDA curves. With a stop rule (``intensity.ida.stop_when``) the run table is still the full
+grid, with the same ids: the runs of one curve (:func:`curve_key`) are run in increasing order
+in one task, and those above the level where the rule holds are stored with status "skipped".
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ import numpy as np
 
 from seisrack.errors import InputError, SeisrackError
 from seisrack.motion.records import Record
-from seisrack.studies.spec import StudySpec
+from seisrack.studies.spec import IdaStop, StudySpec
 
 RECORD_SUFFIXES = (".at2", ".csv", ".txt")
 
@@ -65,6 +69,7 @@ class StudyPlan:
     patterns: dict
     records: dict
     dt: float
+    ida_stop: IdaStop | None = None  # the IDA stop rule (None: every level runs)
 
 
 def expand(spec: StudySpec) -> list[Run]:
@@ -116,7 +121,14 @@ def plan(spec: StudySpec) -> StudyPlan:
                          "values giving distinct runs (two runs of the study are identical)",
                          source=spec.source)
     return StudyPlan(runs=tuple(runs), racks=racks, patterns=patterns,
-                     records={h: r for _, h, r in records}, dt=spec.dt)
+                     records={h: r for _, h, r in records}, dt=spec.dt,
+                     ida_stop=intensity.ida_stop if intensity.is_ida else None)
+
+
+def curve_key(run: Run) -> tuple:
+    """The IDA curve of ``run``: (rack, occupancy, record, friction); levels vary along it."""
+    return (run.rack_hash, run.occupancy, run.record, run.record_hash, run.mu_static,
+            run.mu_dynamic)
 
 
 def run_id(rack_hash: str, record: str, record_hash: str, measure: str, target: float,

@@ -8,6 +8,13 @@ every worker gets work). Rows come back as batches finish and wait in a buffer o
 file: the driver's memory does not grow with the study. On Ctrl-C the buffer is flushed before
 the interrupt propagates; a driver killed outright loses at most its buffer, which a resumed run
 recomputes.
+
+IDA with a stop rule: batches hold whole IDA curves (the worker runs a curve's levels in order
+and skips those above the level where the rule holds); the rows of one batch are written in
+one part file, so a curve is stored whole or not at all. A stored "skipped" row counts as done
+while the study's rule is the one that skipped it; with another rule (or none) the level is run
+again. Levels missing from the store above a stored level where the rule holds (e.g. a grid
+extended upwards) are recorded as skipped by the driver without a task.
 """
 
 from __future__ import annotations
@@ -20,9 +27,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from seisrack.errors import InputError
-from seisrack.studies.expand import Run, StudyPlan, plan
-from seisrack.studies.spec import StudySpec
-from seisrack.studies.store import stored_run_ids, write_part, write_study_json
+from seisrack.studies.expand import Run, StudyPlan, curve_key, plan
+from seisrack.studies.spec import IdaStop, StudySpec
+from seisrack.studies.store import (
+    part_files,
+    read_runs,
+    stored_run_ids,
+    write_part,
+    write_study_json,
+)
 
 log = logging.getLogger(__name__)
 
@@ -37,22 +50,73 @@ class StudyRunSummary:
     out_dir: str
     runs_total: int  # runs of the study
     runs_already_stored: int  # skipped (resume)
-    runs_executed: int
+    runs_executed: int  # run by a worker (ok + failed)
     runs_ok: int  # of the executed runs
     runs_failed: int
+    runs_skipped: int  # IDA levels above a stop rule's level, recorded without being run
     wall_time_s: float
     executor: str
     workers: int
     part_files_written: int
 
 
-def make_batches(runs: Sequence[Run], workers: int, batch_size: int | None = None
-                 ) -> list[list[Run]]:
-    """Consecutive batches: ``batch_size`` runs each, or fewer so every worker gets ~4."""
+def make_batches(runs: Sequence[Run], workers: int, batch_size: int | None = None,
+                 *, by_curve: bool = False) -> list[list[Run]]:
+    """Consecutive batches: ``batch_size`` runs each, or fewer so every worker gets ~4.
+
+    by_curve: never split an IDA curve (:func:`~seisrack.studies.expand.curve_key`): whole
+    curves are packed up to ``batch_size`` runs, a longer curve is a batch of its own.
+    """
     if not runs:
         return []
     size = batch_size or max(1, min(DEFAULT_BATCH, math.ceil(len(runs) / (4 * workers))))
-    return [list(runs[i:i + size]) for i in range(0, len(runs), size)]
+    if not by_curve:
+        return [list(runs[i:i + size]) for i in range(0, len(runs), size)]
+    curves: dict = {}
+    for r in runs:
+        curves.setdefault(curve_key(r), []).append(r)
+    batches: list[list[Run]] = [[]]
+    for c in curves.values():
+        if batches[-1] and len(batches[-1]) + len(c) > size:
+            batches.append([])
+        batches[-1].extend(c)
+    return batches
+
+
+def _todo_with_rule(runs: Sequence[Run], out: Path, rule: IdaStop
+                    ) -> tuple[list[Run], list[dict]]:
+    """(runs to execute, rows of runs skipped by the driver) under the IDA stop ``rule``.
+
+    Stored rows are done, except "skipped" rows of another rule. In a curve, a missing level
+    above the lowest stored level where the rule holds is skipped without a task.
+    """
+    from seisrack.studies.executors import skipped_row
+
+    stored = {}
+    if part_files(out):
+        table = read_runs(out, columns=["error", "any_fall", "peak_sliding_max_m"])
+        stored = {row["run_id"]: row for row in table.to_pylist()}
+    reason_end = f"by rule {rule.label}"
+    todo: list[Run] = []
+    skipped: list[dict] = []
+    curves: dict = {}
+    for r in runs:
+        curves.setdefault(curve_key(r), []).append(r)
+    for curve in curves.values():
+        stop = None
+        for r in sorted(curve, key=lambda r: r.im_target):
+            row = stored.get(r.run_id)
+            if row is not None and row["status"] == "skipped" and not row[
+                    "error"].endswith(reason_end):
+                row = None  # skipped by another rule: run it (or skip it) under this one
+            if row is not None:
+                if stop is None and rule.holds(row):
+                    stop = r
+            elif stop is not None:
+                skipped.append(skipped_row(r, stop.im_target, rule))
+            else:
+                todo.append(r)
+    return todo, skipped
 
 
 def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str = "local",
@@ -82,12 +146,21 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
     out = Path(out_dir)
     if isinstance(spec, StudySpec):
         write_study_json(out, spec, pl.runs)
-    done = stored_run_ids(out)
-    todo = [r for r in pl.runs if r.run_id not in done]
+    rule = pl.ida_stop
+    pre_skipped: list[dict] = []
+    if rule is None:
+        done = stored_run_ids(out, skipped=False)  # skipped by a rule no longer set: run
+        todo = [r for r in pl.runs if r.run_id not in done]
+    else:
+        todo, pre_skipped = _todo_with_rule(pl.runs, out, rule)
+    n_missing = len(todo) + len(pre_skipped)
     n_workers = workers or os.cpu_count() or 1
     log.info("study: %d runs, %d already stored, %d to run on %s (%d workers)",
-             len(pl.runs), len(pl.runs) - len(todo), len(todo), executor, n_workers)
-    ok = failed = parts = 0
+             len(pl.runs), len(pl.runs) - n_missing, len(todo), executor, n_workers)
+    ok = failed = skipped = parts = 0
+    if pre_skipped:
+        parts += write_part(out, pre_skipped) is not None
+        skipped = len(pre_skipped)
     if todo:
         if executor == "local":
             from seisrack.studies.executors import LocalExecutor
@@ -100,13 +173,15 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
         bar = _bar(len(todo), progress)
         buffer: list[dict] = []
         last = time.monotonic()
-        stream = ex.run(make_batches(todo, n_workers, batch_size))
+        stream = ex.run(make_batches(todo, n_workers, batch_size, by_curve=rule is not None))
         try:
             for rows in stream:
                 buffer.extend(rows)
-                n_bad = sum(r["status"] != "ok" for r in rows)
+                n_bad = sum(r["status"] == "failed" for r in rows)
+                n_skip = sum(r["status"] == "skipped" for r in rows)
                 failed += n_bad
-                ok += len(rows) - n_bad
+                skipped += n_skip
+                ok += len(rows) - n_bad - n_skip
                 if bar is not None:
                     bar.update(len(rows))
                     bar.set_postfix(failed=failed, refresh=False)
@@ -120,8 +195,9 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
             if bar is not None:
                 bar.close()
     return StudyRunSummary(out_dir=str(out), runs_total=len(pl.runs),
-                           runs_already_stored=len(pl.runs) - len(todo),
+                           runs_already_stored=len(pl.runs) - n_missing,
                            runs_executed=ok + failed, runs_ok=ok, runs_failed=failed,
+                           runs_skipped=skipped,
                            wall_time_s=time.perf_counter() - t0, executor=executor,
                            workers=n_workers, part_files_written=parts)
 

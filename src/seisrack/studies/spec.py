@@ -24,6 +24,7 @@ from seisrack.motion.records import G
 
 MEASURES = ("pga", "sa")
 DISTRIBUTIONS = ("lognormal", "uniform", "truncnormal")
+STOP_RULES = ("fall", "sliding")  # intensity.ida.stop_when
 DEFAULT_DT = 0.005  # s, analysis step
 DEFAULT_MAX_SCALE = 50.0  # largest scale factor accepted on a record
 _TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed")
@@ -55,11 +56,41 @@ class RecordsSpec:
 
 
 @dataclass(frozen=True)
+class IdaStop:
+    """The stop rule of an IDA curve (``intensity.ida.stop_when``).
+
+    An IDA curve (one rack, record, friction sample and occupancy) runs its levels in
+    increasing order and stops at the first level whose run is "ok" and where the rule holds:
+    ``"fall"``: any pallet falls (``any_fall``); ``"sliding"``: ``peak_sliding_max_m`` >
+    ``sliding_m`` [m]. The levels above are not run (status "skipped").
+    """
+
+    when: str  # "fall" or "sliding"
+    sliding_m: float = math.nan  # [m] threshold of "sliding"
+
+    @property
+    def label(self) -> str:
+        """The rule as written in the study file (also in the reason of a skipped run)."""
+        if self.when == "sliding":
+            return f'stop_when = "sliding", sliding_m = {self.sliding_m!r}'
+        return f'stop_when = "{self.when}"'
+
+    def holds(self, row: dict) -> bool:
+        """Whether the rule stops the curve at the run of ``row`` (a store row)."""
+        if row.get("status") != "ok":
+            return False  # a failed run tells nothing: the curve goes on
+        if self.when == "fall":
+            return bool(row["any_fall"])
+        return bool(row["peak_sliding_max_m"] > self.sliding_m)
+
+
+@dataclass(frozen=True)
 class IntensitySpec:
     """The intensity measure and the levels the records are scaled to.
 
     stripes: (n,) [m/s²] targets (multiple-stripe analysis), or ``ida`` (incremental dynamic
-    analysis on a fixed grid ``start, start + step, …`` up to ``stop``).
+    analysis on a fixed grid ``start, start + step, …`` up to ``stop``), with an optional
+    stop rule ``ida_stop`` (each IDA curve stops at the first level where it holds).
     """
 
     measure: str = "pga"  # "pga" or "sa" (Sa(T1, damping) of the rack's first mode)
@@ -67,6 +98,7 @@ class IntensitySpec:
     ida: tuple[float, ...] = ()  # [m/s²] the IDA grid, expanded
     damping: float = 0.05
     max_scale: float = DEFAULT_MAX_SCALE
+    ida_stop: IdaStop | None = None
 
     @property
     def levels(self) -> tuple[float, ...]:
@@ -226,12 +258,18 @@ def _intensity(t: Table) -> IntensitySpec:
     if damping >= 1.0:
         raise t.error("damping", damping, "a damping ratio in [0, 1)")
     max_scale = t.number("max_scale", DEFAULT_MAX_SCALE, positive=True)
+    for key in ("stop_when", "sliding_m"):
+        if t.has(key):
+            raise t.error(key, t.data[key], "no key here: a stop rule applies to IDA only and "
+                          "is written in the ida table, e.g. ida = {start = 0.1, step = 0.1, "
+                          f"stop = 1.0, {key} = ...}}")
     if t.has("stripes") == t.has("ida"):
         raise t.error("stripes", t.data.get("stripes"),
                       "exactly one of 'stripes' (an array of levels) or 'ida' (a table "
                       "{start, step, stop})")
     stripes: tuple[float, ...] = ()
     ida: tuple[float, ...] = ()
+    ida_stop = None
     if t.has("stripes"):
         raw = t.array("stripes")
         if not raw:
@@ -246,7 +284,8 @@ def _intensity(t: Table) -> IntensitySpec:
         start = it.number("start", positive=True, unit=unit)
         step = it.number("step", positive=True, unit=unit)
         stop = it.number("stop", positive=True, unit=unit)
-        it.finish(("start", "step", "stop"))
+        ida_stop = _ida_stop(it)
+        it.finish(("start", "step", "stop", "stop_when", "sliding_m"))
         if stop < start:
             raise it.error("stop", stop, f"a level >= start ({start:g} {unit})")
         n = int(math.floor((stop - start) / step + 1e-9)) + 1
@@ -255,7 +294,30 @@ def _intensity(t: Table) -> IntensitySpec:
         ida = tuple(factor * (start + k * step) for k in range(n))
     t.finish(("measure", "unit", "stripes", "ida", "damping", "max_scale"))
     return IntensitySpec(measure=measure, stripes=stripes, ida=ida, damping=damping,
-                         max_scale=max_scale)
+                         max_scale=max_scale, ida_stop=ida_stop)
+
+
+def _ida_stop(it: Table) -> IdaStop | None:
+    """The stop rule of ``intensity.ida`` (None without ``stop_when``)."""
+    if not it.has("stop_when"):
+        if it.has("sliding_m"):
+            raise it.error("sliding_m", it.data["sliding_m"], "no sliding_m without "
+                           'stop_when = "sliding" (the threshold of the sliding stop rule)')
+        return None
+    when = it.string("stop_when")
+    if when not in STOP_RULES:
+        raise it.error("stop_when", when, '"fall" (stop at the first level where a pallet '
+                       'falls) or "sliding" (stop when the peak sliding exceeds sliding_m)')
+    if when == "fall":
+        if it.has("sliding_m"):
+            raise it.error("sliding_m", it.data["sliding_m"],
+                           'no sliding_m with stop_when = "fall" (it is the threshold of '
+                           'stop_when = "sliding")')
+        return IdaStop(when)
+    if not it.has("sliding_m"):
+        raise it.error("sliding_m", None, 'a sliding threshold > 0 [m] with stop_when = '
+                       '"sliding"')
+    return IdaStop(when, it.number("sliding_m", positive=True, unit="m"))
 
 
 def _friction(t: Table) -> FrictionSpec:

@@ -14,7 +14,9 @@ stored. Each part is written under a temporary name in the same folder and renam
 resumed study reads the run ids already stored and runs the others.
 
 :func:`read_runs` deduplicates by ``run_id`` (a run stored twice, e.g. by a driver killed
-between writing a part and noticing it, counts once) and sorts by ``run_id``.
+between writing a part and noticing it, counts once) and sorts by ``run_id``. A run stored both
+as "skipped" (an IDA level above a stop rule's level) and as run (the rule was changed or
+removed, and the level run on resume) is returned as run.
 """
 
 from __future__ import annotations
@@ -80,26 +82,47 @@ def part_files(out_dir: str | Path) -> list[Path]:
     return sorted(runs.glob("part-*.parquet")) if runs.is_dir() else []
 
 
-def stored_run_ids(out_dir: str | Path) -> set[str]:
-    """Ids of the runs already in the store (reads the ``run_id`` column only)."""
+def stored_run_ids(out_dir: str | Path, *, skipped: bool = True) -> set[str]:
+    """Ids of the runs already in the store (reads the ``run_id`` column only).
+
+    skipped: False leaves out the runs stored only as "skipped" (IDA levels above a stop rule's
+    level: not run).
+    """
     import pyarrow.parquet as pq
 
     ids: set[str] = set()
     for p in part_files(out_dir):
-        ids.update(pq.read_table(p, columns=["run_id"]).column(0).to_pylist())
+        if skipped:
+            ids.update(pq.read_table(p, columns=["run_id"]).column(0).to_pylist())
+            continue
+        t = pq.read_table(p, columns=["run_id", "status"]).to_pydict()
+        ids.update(i for i, st in zip(t["run_id"], t["status"], strict=True)
+                   if st != "skipped")
     return ids
 
 
-def read_runs(out_dir: str | Path):  # noqa: ANN201
-    """Every stored run as a ``pyarrow.Table``: one row per ``run_id``, sorted by ``run_id``."""
+def read_runs(out_dir: str | Path, columns: list[str] | None = None):  # noqa: ANN201
+    """Every stored run as a ``pyarrow.Table``: one row per ``run_id``, sorted by ``run_id``.
+
+    columns: read only these (``run_id`` and ``status`` are always read); default all.
+    Of a run stored twice, a row that was run is kept before a "skipped" one.
+    """
     import numpy as np
     import pyarrow as pa
+    import pyarrow.compute as pc
     import pyarrow.parquet as pq
 
-    parts = [pq.read_table(p, schema=schema()) for p in part_files(out_dir)]
+    sch = schema()
+    if columns is not None:
+        keep = {"run_id", "status", *columns}
+        sch = pa.schema([f for f in sch if f.name in keep])
+    parts = [pq.read_table(p, schema=sch, columns=sch.names) for p in part_files(out_dir)]
     if not parts:
-        return schema().empty_table()
-    table = pa.concat_tables(parts).sort_by("run_id")
+        return sch.empty_table()
+    table = pa.concat_tables(parts)
+    skipped = pc.equal(table.column("status"), "skipped").cast(pa.int8())
+    table = table.append_column("_skipped", skipped).sort_by(
+        [("run_id", "ascending"), ("_skipped", "ascending")]).drop_columns(["_skipped"])
     ids = np.asarray(table.column("run_id").to_pylist(), dtype=object)
     if ids.size:
         first = np.ones(ids.size, dtype=bool)
@@ -125,7 +148,9 @@ def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa
         "seed": spec.seed,
         "intensity": {"measure": spec.intensity.measure,
                       "levels_m_s2": list(spec.intensity.levels),
-                      "kind": "ida" if spec.intensity.is_ida else "stripes"},
+                      "kind": "ida" if spec.intensity.is_ida else "stripes",
+                      "ida_stop_rule": (spec.intensity.ida_stop.label
+                                        if spec.intensity.ida_stop else None)},
         "runs": [asdict(r) for r in runs],
     }
     path = out / STUDY_JSON

@@ -14,7 +14,11 @@ runs are counted with their reasons.
   ``any_fall``, and ``base_shear>V`` when a capacity V [N] is given. Bands: 5-95 % bootstrap
   percentiles (runs resampled within each stripe).
 - *IDA* (``stripe == -1``): one curve per (record, friction, occupancy); the IM of first
-  exceedance per curve gives the method-of-moments fit, bootstrap over the curves.
+  exceedance per curve gives the method-of-moments fit, bootstrap over the curves. A curve
+  stopped by the study's stop rule (its levels above are "skipped" runs) counts as exceeding
+  every damage state at its first skipped level (the collapse convention of IDA, Vamvatsikos &
+  Cornell 2002): a state not reached up to the stop level gets the stop level as capacity
+  (the linear crossing towards an infinite response); ``stopped_im`` gives that level.
 
 Theta is in the units of the intensity measure as stored: m/s² for both PGA and Sa.
 """
@@ -181,20 +185,32 @@ def _ida(r, idx, states, n_boot, seed) -> dict[str, Any]:
         rows = ok[(r["record"][ok] == rec) & (r["mu_static"][ok] == mu_s)
                   & (r["mu_dynamic"][ok] == mu_d) & (r["occupancy"][ok] == occ)]
         rows = rows[np.argsort(r["im_target"][rows], kind="stable")]
+        skip = idx[(r["status"][idx] == "skipped") & (r["record"][idx] == rec)
+                   & (r["mu_static"][idx] == mu_s) & (r["mu_dynamic"][idx] == mu_d)
+                   & (r["occupancy"][idx] == occ)]
         cv = {"record": rec, "mu_static": _nan(mu_s), "occupancy": _nan(occ),
-              "im": r["im_target"][rows].tolist()}
+              "im": r["im_target"][rows].tolist(),
+              "stopped_im": float(r["im_target"][skip].min()) if skip.size else None}
         for c in PEAKS + ("any_fall",):
             cv[c] = [_nan(v) for v in r[c][rows]]
         curves.append(cv)
     fits = {}
     for i, (name, col, thr) in enumerate(states):
-        cap = np.array([fr.ida_capacity(cv["im"], np.array(cv[col], dtype=float), thr)
-                        for cv in curves]) if curves else np.zeros(0)
+        cap = np.array([_capacity(cv, col, thr) for cv in curves]) if curves else np.zeros(0)
         fit = fr.fit_ida_fragility(cap)
         th, be = fr.bootstrap_ida_fragility(cap, n_boot, seed + i)
         fits[name] = _band_fields(fit, th, be)
         fits[name]["capacities"] = [_nan(c) for c in cap]
     return {"curves": curves, "fragility": fits, "n_ok": int(ok.size)}
+
+
+def _capacity(cv: dict[str, Any], col: str, thr: float) -> float:
+    """IM of first exceedance of one IDA curve; a stopped curve exceeds at ``stopped_im``."""
+    im, edp = list(cv["im"]), np.array(cv[col], dtype=float)
+    if cv.get("stopped_im") is not None:
+        im.append(cv["stopped_im"])
+        edp = np.append(edp, math.inf)
+    return fr.ida_capacity(im, edp, thr)
 
 
 def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: float | None = None,
@@ -224,12 +240,14 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     r = runs_as_arrays(table)
     states = _damage_states(d_slide, shear_capacity)
     status = r["status"]
-    failed = status != "ok"
+    failed = status == "failed"
     reasons = Counter((e.splitlines()[0][:160] if e else "(no reason recorded)")
                       for e in r["error"][failed])
     summary: dict[str, Any] = {
-        "out_dir": str(out), "runs_total": int(status.size), "runs_ok": int((~failed).sum()),
-        "runs_failed": int(failed.sum()), "failure_reasons": dict(reasons.most_common()),
+        "out_dir": str(out), "runs_total": int(status.size),
+        "runs_ok": int((status == "ok").sum()),
+        "runs_failed": int(failed.sum()), "runs_skipped": int((status == "skipped").sum()),
+        "failure_reasons": dict(reasons.most_common()),
         "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
         "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
         "fragility": [],
@@ -339,7 +357,8 @@ def _fmt(x: Any, spec: str = ".3g") -> str:
 def format_summary(s: dict[str, Any]) -> str:
     """A readable text summary of :func:`summarize`'s result."""
     lines = [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
-             f"{s['runs_failed']} failed"]
+             f"{s['runs_failed']} failed" + (f", {s['runs_skipped']} skipped (IDA stop rule)"
+                                              if s.get("runs_skipped") else "")]
     for reason, n in s["failure_reasons"].items():
         lines.append(f"  failed x{n}: {reason}")
     for g in s["groups"]:
