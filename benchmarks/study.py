@@ -273,21 +273,17 @@ def report(res: dict, meta: dict) -> str:
               f"- Measured {big['total_s']:.0f} s with {big['children_cpu_s'] / big['run_s']:.2f}"
               " cores obtained from a shared machine (the other agents' jobs held the rest).",
               f"- On two free cores the same work would take about {est_cpu:.0f} s (workers' CPU "
-              f"/ 2) or {est_inproc:.0f} s (in-process CPU per run x 10,000 / 2): the target "
-              "is not met by the engine's per-run cost, whatever the executor (the machinery "
-              "itself costs < 0.3 ms per run, see below).",
-              f"- A run on a 0.1 s record costs {ip['short_cpu_ms']:.1f} ms: a fixed cost per "
-              "run paid before and after the time stepping. Without it the 10,000 runs would "
-              f"need about {est_nofixed:.0f} s of two free cores. A cProfile of 95 such runs "
-              "(in-process, 2026-11-23; cumulative times under the profiler, which inflates "
-              "them) puts it in `analysis.peaks.rack_operators` (recovery "
-              "and design operators rebuilt for every run, ~3 ms; they depend on the compiled "
-              "model only and could be cached with it), `threadpoolctl.threadpool_limits` "
-              "entered inside every `run_rack` call (~0.8 ms: it rescans the loaded libraries "
-              "although the worker already holds a one-thread limit) and the low-pass filter "
-              "design `scipy.signal.butter` (~0.7 ms, the same coefficients every run).",
-              "- The 1 -> 2 worker speed-up cannot be measured on this machine while other jobs "
-              "run: both cases obtained about one core (`cores obtained` in the table above). "
+              f"/ 2) or {est_inproc:.0f} s (in-process CPU per run x 10,000 / 2); the study "
+              "machinery itself costs < 0.3 ms per run (see below), so the engine's per-run "
+              "cost decides the target.",
+              f"- A run on a 0.1 s record costs {ip['short_cpu_ms']:.1f} ms: the fixed cost per "
+              "run paid before and after the time stepping (about 4 ms before the study "
+              "workers cached the rack operators with the model, `run_rack` stopped rescanning "
+              "the BLAS libraries on every call and the low-pass filter design was cached). "
+              f"Without it the 10,000 runs would need about {est_nofixed:.0f} s of two free "
+              "cores.",
+              "- The 1 -> 2 worker speed-up depends on the cores other jobs leave free "
+              "(`cores obtained` in the table above). "
               "The workers' CPU for the same 400 runs is "
               f"{res['scale1']['children_cpu_s']:.1f} s on 1 worker and "
               f"{res['scale2']['children_cpu_s']:.1f} s on 2 (the CPU per run grows by "
