@@ -23,9 +23,12 @@ demo: $(STAMP)
 	$(BIN)/seisrack paper --out out/paper
 
 test: $(STAMP)
-	# the HTML report's browser test drives Debian's chromium (about 25 s to install here)
-	if command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && ! command -v chromium >/dev/null; \
-	   then apt-get update -qq && apt-get install -y -qq chromium; fi
+	# the HTML report's browser test drives Debian's chromium (about 25 s to install here), and
+	# the OpenSees cross-checks need OpenSeesPy (the bench extra) with Debian's BLAS/LAPACK
+	if command -v apt-get >/dev/null && [ "$$(id -u)" = 0 ] && { ! command -v chromium \
+	   >/dev/null || ! dpkg -s libblas3 liblapack3 >/dev/null 2>&1; }; then \
+	   apt-get update -qq && apt-get install -y -qq chromium libblas3 liblapack3; fi
+	$(BIN)/python -m pip install --quiet -e '.[bench]'
 	$(BIN)/python -m ruff check src tests benchmarks
 	$(BIN)/python -m pytest -n 2 -q tests
 

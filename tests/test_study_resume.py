@@ -33,8 +33,11 @@ from test_study_spec import make_study
 
 EXTRA_STRIPES = ("stripes = [0.1, 0.3, 0.5]", "stripes = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]")
 
+# The driver restores Python's Ctrl-C handler: a process started in the background by a
+# non-interactive shell (a CI runner, `cmd &`) inherits SIGINT as ignored, unlike a terminal.
 DRIVER = """
-import sys
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
 from seisrack.studies import load_study, run_study
 run_study(load_study(sys.argv[1]), sys.argv[2], workers=1, batch_size=1, flush_rows=1,
           progress=False)
