@@ -39,6 +39,20 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
     return p
 
 
+def write_atomically(p: Path, text: str) -> Path:
+    """Write ``text`` to a temporary file beside ``p``, then rename it: a reader never sees a
+    half-written report, and a failed write leaves what was there."""
+    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, p)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise InputError("path", str(p), "a writable path",
+                         hint=str(exc.strerror or exc)) from None
+    return p
+
+
 def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, response: Any,
                       record: Any, summary: dict[str, Any], modal: Any = None,
                       checks: dict[str, Any] | None = None, force: bool = False,
@@ -58,12 +72,4 @@ def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, re
                       design_spectrum=design_spectrum, rack_file=rack_file, seed=seed,
                       interactive=interactive, date=_dt.datetime.now().isoformat(
                           timespec="seconds"))
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, p)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise InputError("path", str(p), "a writable path",
-                         hint=str(exc.strerror or exc)) from None
-    return p
+    return write_atomically(p, text)

@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from seisrack import __version__
-from seisrack.errors import InputError
 from seisrack.report.html import figures as F
 from seisrack.report.html.page import _figure
 from seisrack.report.html.style import CSS
@@ -381,18 +380,10 @@ def write_study_report(path: str | os.PathLike[str], summary: dict[str, Any], *,
     seed: the bootstrap seed (shown). Raises InputError if ``path`` exists (without ``force``)
     or cannot be written.
     """
-    from seisrack.report.html import check_report_path
+    from seisrack.report.html import check_report_path, write_atomically
 
     p = check_report_path(path, force)
     study = read_study_json(out_dir if out_dir is not None else summary.get("out_dir", "."))
     text = build_study_html(summary, study=study, boots=boots, seed=seed,
                             date=_dt.datetime.now().isoformat(timespec="seconds"))
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, p)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise InputError("path", str(p), "a writable path",
-                         hint=str(exc.strerror or exc)) from None
-    return p
+    return write_atomically(p, text)
