@@ -225,3 +225,22 @@ def test_local_reader_dedups_and_sorts(tmp_path):
     table = _read_runs_local(tmp_path)
     assert table.column("run_id").to_pylist() == ["r00001", "r00002", "r00003"]
     assert _read_runs_local(tmp_path / "nowhere").num_rows == 0
+
+
+def test_example_study_gives_a_proper_fragility(tmp_path) -> None:
+    """The shipped example (issue 13) brackets the sliding onset: every fit is an ordinary
+    lognormal (status ok, 0 < beta), not a step, and theta lies inside the stripes."""
+    from pathlib import Path
+
+    from seisrack.studies import load_study, run_study
+    from seisrack.studies.summary import summarize
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "study_paper_rack.toml"
+    out = tmp_path / "study"
+    run_study(load_study(example), out, workers=2, progress=False)
+    s = summarize(out, n_boot=50, plots=False)
+    assert (s["runs_total"], s["runs_ok"], s["runs_failed"]) == (72, 72, 0)
+    fits = s["fragility"]
+    assert fits and all(f["status"] == "ok" for f in fits)
+    g = 9.80665
+    assert all(0.0 < f["beta"] < 1.0 and 0.3 * g < f["theta"] < 0.5 * g for f in fits)

@@ -101,7 +101,9 @@ def _run_study(args: argparse.Namespace) -> int:
         print_json(asdict(s))
         return 0
     print(f"{s.runs_total} runs: {s.runs_already_stored} already stored, {s.runs_executed} run "
-          f"({s.runs_ok} ok, {s.runs_failed} failed) in {s.wall_time_s:.1f} s on {s.executor} "
+          f"({s.runs_ok} ok, {s.runs_failed} failed)"
+          + (f", {s.runs_skipped} skipped by the IDA stop rule" if s.runs_skipped else "")
+          + f" in {s.wall_time_s:.1f} s on {s.executor} "
           f"({s.workers} workers); results in {s.out_dir}/runs")
     return 0
 
