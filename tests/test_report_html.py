@@ -149,3 +149,23 @@ def test_cli_report_writes_html_and_summary(tmp_path, capsys):
     assert "--force" in capsys.readouterr().err
     assert main(["report", str(EXAMPLES / "three_level_rack.toml"), "--builtin",
                  "elcentro_1940_ns", "--out", str(out), "--force"]) == 0
+
+
+def test_cli_report_scales_the_record_and_runs_the_rigid_check(tmp_path, capsys):
+    """--scale-pga reaches the run (its ground peak equals the target) and the report;
+    --rigid-check makes alpha come from the rigid-pallet run."""
+    from seisrack.cli import main
+
+    out = tmp_path / "report.html"
+    rc = main(["report", str(EXAMPLES / "paper_rack.toml"), "--builtin", "elcentro_1940_ns",
+               "--scale-pga", "2.5", "--rigid-check", "--out", str(out), "--json"])
+    assert rc == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["scaling"]["method"] == "pga"
+    assert s["scaling"]["pga_after"] == pytest.approx(2.5, rel=1e-12)
+    assert s["simplified_check"]["alpha_source"] == "rigid companion run"
+    assert "scaling" in out.read_text(encoding="utf-8")
+    (tmp_path / "bad").mkdir()
+    assert main(["report", str(EXAMPLES / "paper_rack.toml"), "--builtin", "elcentro_1940_ns",
+                 "--scale-pga", "-1", "--out", str(tmp_path / "bad" / "x.html")]) == 2
+    assert "--scale-pga" in capsys.readouterr().err

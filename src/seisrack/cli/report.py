@@ -34,7 +34,13 @@ def register(subparsers: Any) -> None:
                    help="modes in the modal table and the checks (default 6)")
     p.add_argument("--out", default="report.html", metavar="FILE.html",
                    help="the HTML report (default report.html); summary.json goes beside it")
+    p.add_argument("--rigid-check", action="store_true",
+                   help="also run the rack with rigidly held pallets, so the mu >= alpha rule "
+                        "uses the designer's (rigid) alpha")
     p.add_argument("--force", action="store_true", help="overwrite an existing report")
+    from seisrack.cli.run import _register_scaling
+
+    _register_scaling(p)
     p.add_argument("--json", action="store_true",
                    help="print the summary with the design checks as one JSON object")
     p.set_defaults(func=run)
@@ -44,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.analysis import run_rack
     from seisrack.checks import run_design_checks
     from seisrack.cli._common import print_json
-    from seisrack.cli.run import _records
+    from seisrack.cli.run import _apply_scaling, _records
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
     from seisrack.model import compile_rack, load_rack, with_friction
@@ -67,11 +73,14 @@ def run(args: argparse.Namespace) -> int:
         spec = with_friction(spec, args.mu)
     model = compile_rack(spec)
     rec, _ = _records(args)
-    resp = run_rack(model, rec)
+    rec, _, scaling = _apply_scaling(args, model, rec, None)
+    resp = run_rack(model, rec, rigid_companion=args.rigid_check)
     modal = modal_analysis(model, n_modes=min(args.modes, model.n_dof))
     checks = run_design_checks(model, resp, modal=modal, spectrum=design, record=rec)
     summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
                "integration": resp.history.method, "basis": resp.history.basis}
+    if scaling is not None:
+        summary["scaling"] = scaling
     summary["design_checks"] = checks
     write_html_report(out, spec=spec, model=model, response=resp, record=rec, summary=summary,
                       modal=modal, checks=checks, force=args.force, design_spectrum=design,
