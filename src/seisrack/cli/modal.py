@@ -47,12 +47,16 @@ def run(args: argparse.Namespace) -> int:
             "cumulative_mass_participation": cum,
             "effective_mass_x_kg": res.effective_mass_x, "total_mass_x_kg": res.total_mass_x,
             "damping_coefficients": list(model.damping_coefficients),
+            "critical_load_factor": model.critical_load_factor,
             "plot": args.plot,
         })
         return 0
     print(f"{spec.title or args.rack}")
     print(f"{model.n_dof} DOFs, horizontal mass {res.total_mass_x:.1f} kg "
           "(pallets rigidly attached)")
+    if model.critical_load_factor is not None:
+        print(f"P-Δ on ({spec.second_order.form} geometric stiffness of the gravity load): "
+              f"critical load factor {model.critical_load_factor:.4g}")
     print(f"{'mode':>4} {'period [s]':>11} {'freq [Hz]':>10} {'particip.':>10} {'cumul.':>8}")
     for k in range(res.n_modes):
         print(f"{k + 1:>4} {res.periods[k]:>11.4f} {res.frequencies[k]:>10.3f} "

@@ -3,8 +3,11 @@
 Steps: mesh (:mod:`seisrack.model.rack_mesh`) → vectorised sparse assembly of K and consistent
 M (:mod:`seisrack.fe.assembly`) → stability check (sparse LDLᵀ pivots,
 :func:`seisrack.fe.stability.is_positive_definite`) → pallets (vertical mass on their node's uy
-DOF; horizontal mass kept apart as sliders) → damping (:mod:`seisrack.fe.damping`, the first
-period by sparse shift-invert Lanczos). Nothing here forms a dense (n_dof, n_dof) matrix.
+DOF; horizontal mass kept apart as sliders) → optional P-Δ (``[second_order]``: K = K_E + K_G
+with the axial forces of a linear static gravity solve, :mod:`seisrack.fe.geometric`, and the
+critical load factor) → damping (:mod:`seisrack.fe.damping`, the first
+period by sparse shift-invert Lanczos). Nothing here forms a dense (n_dof, n_dof) matrix
+beyond 500 DOFs (the P-Δ buckling factor of a small rack is a dense LAPACK solve).
 """
 
 from __future__ import annotations
@@ -17,8 +20,9 @@ import scipy.sparse as sp
 
 from seisrack.errors import InputError
 from seisrack.fe import damping as fe_damping
+from seisrack.fe import geometric
 from seisrack.fe.assembly import assemble_sparse, symmetric_csr
-from seisrack.fe.mesh import FloatArray
+from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.fe.modal import modal_from_matrices
 from seisrack.fe.stability import is_positive_definite
 from seisrack.model.frame_model import FrameModel
@@ -45,6 +49,9 @@ def compile_rack(spec: RackSpec) -> FrameModel:
 
     r_x = _influence(mesh.node_dofs[:, 0], mesh.n_dof)
     r_y = _influence(mesh.node_dofs[:, 1], mesh.n_dof)
+    lam_cr = None
+    if spec.second_order.p_delta:
+        K, lam_cr = _p_delta(spec, mesh, K, M, r_y)
     Mt = M + _diagonal(p_dof, p_mass, mesh.n_dof)  # pallets rigidly attached
     a0, a1 = _damping(spec, K, Mt, r_x, r_y)
     C = symmetric_csr(a0 * M + a1 * K)
@@ -71,7 +78,7 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         upright_base_elements=rm.upright_base_elements,
         upright_below_elements=rm.upright_below_elements,
         upright_above_elements=rm.upright_above_elements,
-        member_mass=member_mass, g=spec.g, title=spec.title,
+        member_mass=member_mass, g=spec.g, title=spec.title, critical_load_factor=lam_cr,
     ))
 
 
@@ -146,6 +153,30 @@ def _check_stable(K: sp.csr_matrix, spec: RackSpec) -> None:
             "connections that make the frame stable (pinned bases need beam-to-upright "
             "joints with a stiffness > 0)", source=spec.source,
             hint="The stiffness matrix is singular: the frame is a sway mechanism")
+
+
+def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matrix,
+             r_y: FloatArray) -> tuple[sp.csr_matrix, float]:
+    """K_E + K_G and the critical load factor; InputError if the gravity load buckles the rack.
+
+    Gravity load F = -g·M·r_y: with the consistent member mass this is the consistent load
+    vector of the members' self weight (a rigid vertical translation is exact in the element's
+    shape functions), plus each pallet's weight on its node's uy DOF.
+    """
+    form = spec.second_order.form
+    N = geometric.gravity_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
+    K_G = geometric.geometric_stiffness(mesh, N, form)
+    lam = geometric.critical_load_factor(K_E, K_G)
+    if lam <= 1.0:
+        raise InputError(
+            "second_order.p_delta", True,
+            "a rack that is stable under its own gravity load (critical load factor > 1)",
+            source=spec.source,
+            hint=f"The critical load factor of the gravity load is {lam:.4g} <= 1: the uprights "
+                 "buckle under the members' and pallets' weight. Use stiffer uprights, base "
+                 "plates or connectors, or lighter pallets")
+    log.info("P-Δ (%s form): critical load factor %.4g", form, lam)
+    return symmetric_csr(K_E + K_G), lam
 
 
 def _damping(spec: RackSpec, K: sp.csr_matrix, Mt: sp.csr_matrix, r_x: FloatArray,

@@ -62,6 +62,12 @@ class FrameModel:
             ending at / starting from each level node (-1 above the top level).
         member_mass: [kg] total mass of all members (including mass on restrained DOFs).
         g: [m/s²].
+
+    Second order:
+        critical_load_factor: with ``[second_order] p_delta = true``, the lowest λ with
+            det(K_E + λ K_G) = 0 for the gravity load (``K_sparse`` is then K_E + K_G, see
+            :mod:`seisrack.fe.geometric`); ``inf`` if nothing is compressed; None when P-Δ
+            is off (``K_sparse`` = K_E).
     """
 
     mesh: FrameMesh
@@ -93,6 +99,7 @@ class FrameModel:
     member_mass: float
     g: float
     title: str = ""
+    critical_load_factor: float | None = None
 
     @property
     def n_dof(self) -> int:

@@ -32,11 +32,12 @@ from seisrack.model.spec import (
     Material,
     Pallet,
     RackSpec,
+    SecondOrder,
     Section,
 )
 
 _TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping",
-             "loading", "pallets")
+             "second_order", "loading", "pallets")
 _LINE_RE = re.compile(r"\(at line (\d+), column (\d+)\)")
 _GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
 
@@ -71,6 +72,7 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     geometry = _geometry(root.table("geometry"), sections)
     connections = _connections(root.table("connections"))
     damping = _damping(root.table("damping", {}))
+    second_order = _second_order(root.table("second_order", {}))
     raw_pallets = root.array("pallets", [])
     explicit = tuple(
         _pallet(Table(p, f"pallets[{i}]", source), geometry) for i, p in enumerate(raw_pallets)
@@ -81,7 +83,7 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
-                    title=title, source=source)
+                    title=title, source=source, second_order=second_order)
 
 
 __all__ = ["check_friction", "load_rack", "rack_from_dict"]
@@ -208,6 +210,17 @@ def _damping(t: Table) -> Damping:
         t.finish(("kind", "pairs"))
         return Damping(kind="rayleigh", pairs=tuple(pairs))
     raise t.error("kind", kind, '"stiffness", "rayleigh" or "none"')
+
+
+def _second_order(t: Table) -> SecondOrder:
+    p_delta = t.raw("p_delta", False)
+    if not isinstance(p_delta, bool):
+        raise t.error("p_delta", p_delta, "true or false")
+    form = t.string("form", "consistent")
+    if form not in ("consistent", "p_delta_only"):
+        raise t.error("form", form, '"consistent" or "p_delta_only"')
+    t.finish(("p_delta", "form"))
+    return SecondOrder(p_delta=p_delta, form=form)  # type: ignore[arg-type]
 
 
 def _pallet(t: Table, geom: Geometry) -> Pallet:

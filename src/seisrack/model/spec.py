@@ -118,6 +118,20 @@ class Damping:
 
 
 @dataclass(frozen=True)
+class SecondOrder:
+    """Second-order (P-Δ) analysis of the frame under its gravity load.
+
+    ``p_delta``: add the linear geometric stiffness K_G of the gravity axial forces to K.
+    ``form``: ``"consistent"`` (cubic-Hermite geometric stiffness, P-Δ and P-δ) or
+    ``"p_delta_only"`` (the chord term N/L, as OpenSees' ``geomTransf PDelta``); see
+    :mod:`seisrack.fe.geometric`.
+    """
+
+    p_delta: bool = False
+    form: Literal["consistent", "p_delta_only"] = "consistent"
+
+
+@dataclass(frozen=True)
 class Pallet:
     """A pallet resting on the beams of one bay and level.
 
@@ -149,6 +163,7 @@ class RackSpec:
     g: float = DEFAULT_G
     title: str = ""
     source: str | None = None
+    second_order: SecondOrder = field(default_factory=SecondOrder)
 
     def beam_section(self, level: int) -> Section:
         """Section of the beams of 0-based ``level``."""
