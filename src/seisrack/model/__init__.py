@@ -10,12 +10,13 @@ from seisrack.model.spec import (
     Material,
     Pallet,
     RackSpec,
+    SecondOrder,
     Section,
     with_friction,
 )
 
 __all__ = [
     "BEAM", "UPRIGHT", "Connections", "Damping", "FrameModel", "Geometry", "Material", "Pallet",
-    "RackSpec", "Section", "compile_rack", "load_rack", "rack_from_dict", "sliding_limits",
+    "RackSpec", "SecondOrder", "Section", "compile_rack", "load_rack", "rack_from_dict", "sliding_limits",
     "with_friction",
 ]
