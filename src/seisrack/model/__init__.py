@@ -17,6 +17,6 @@ from seisrack.model.spec import (
 
 __all__ = [
     "BEAM", "UPRIGHT", "Connections", "Damping", "FrameModel", "Geometry", "Material", "Pallet",
-    "RackSpec", "SecondOrder", "Section", "compile_rack", "load_rack", "rack_from_dict", "sliding_limits",
-    "with_friction",
+    "RackSpec", "SecondOrder", "Section", "compile_rack", "load_rack", "rack_from_dict",
+    "sliding_limits", "with_friction",
 ]
