@@ -76,6 +76,25 @@ def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
 
 
 @_JIT
+def _sliding_modal_load(psi, P, mud, sig, Na, Nb, a, b, on_struct, stuck, fq, out):
+    """out = Ψᵀ Σ_j P_jᵀ c_j over the sliders sliding on the structure, with
+    c_j = -mu_d,j σ_j (a Na_j + b Nb_j) (the friction force, or its slope in time)."""
+    r = fq.shape[0]
+    for i in range(r):
+        fq[i] = 0.0
+    for j in range(mud.shape[0]):
+        if on_struct[j] and not stuck[j]:
+            c = -mud[j] * sig[j] * (a * Na[j] + b * Nb[j])
+            for i in range(r):
+                fq[i] += P[j, i] * c
+    for k in range(out.shape[0]):
+        acc = 0.0
+        for i in range(r):
+            acc += psi[i, k] * fq[i]
+        out[k] = acc
+
+
+@_JIT
 def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_struct, stuck,
                     sig, w0, wd0, ag0, ag1, N0, N1, out, fq, f0, fs):
     """Input, damping and friction work over a sub-step, in closed form.
@@ -94,31 +113,8 @@ def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_s
     e_d = 0.0
     e_f = 0.0
     # sliding forces on the structure, λ_j(τ) = l0_j + ls_j τ, as modal loads f0 + fs τ
-    r_ = fq.shape[0]
-    for i in range(r_):
-        fq[i] = 0.0
-    for j in range(m):
-        if on_struct[j] and not stuck[j]:
-            l0 = -mud[j] * N0[j] * sig[j]
-            for i in range(r_):
-                fq[i] += P[j, i] * l0
-    for k in range(n):
-        acc = 0.0
-        for i in range(r_):
-            acc += psi[i, k] * fq[i]
-        f0[k] = acc
-    for i in range(r_):
-        fq[i] = 0.0
-    for j in range(m):
-        if on_struct[j] and not stuck[j]:
-            ls = -mud[j] * (N1[j] - N0[j]) * sig[j] / h
-            for i in range(r_):
-                fq[i] += P[j, i] * ls
-    for k in range(n):
-        acc = 0.0
-        for i in range(r_):
-            acc += psi[i, k] * fq[i]
-        fs[k] = acc
+    _sliding_modal_load(psi, P, mud, sig, N0, N0, 1.0, 0.0, on_struct, stuck, fq, f0)
+    _sliding_modal_load(psi, P, mud, sig, N1, N0, 1.0 / h, -1.0 / h, on_struct, stuck, fq, fs)
     for k in range(n):
         c = cc[k]
         w = nu2[k]
