@@ -1,13 +1,44 @@
 """numba-compiled build of ``_events.py``, ``_linalg.py``, ``_kernel.py``, ``_exact_modes.py``,
 ``_exact_config.py`` and ``_kernel_exact.py`` (the same sources, executed in this order with
-``_JIT = njit`` in one namespace)."""
+``_JIT = njit`` in one namespace).
 
+numba's on-disk cache keys each function on the timestamp of *its own* source file, while a
+compiled caller embeds the code of the callees it uses from the other files: after an edit of
+``_exact_modes.py`` alone, ``run_kernel_exact`` would load from the cache with the old callees.
+So the six sources are concatenated into one file named by the hash of their content
+(``__pycache__/_kernels_<hash>.py``, or the temporary folder when the package is read-only),
+and compiled from there: any edit of any of them gives a new file and a fresh cache.
+"""
+
+import hashlib
+import tempfile
 from pathlib import Path
 
 import numba
 
 _JIT = numba.njit(cache=True)
-for _name in ("_events.py", "_linalg.py", "_kernel.py", "_exact_modes.py",
-              "_exact_config.py", "_kernel_exact.py"):
-    _SRC = Path(__file__).with_name(_name)
-    exec(compile(_SRC.read_text(encoding="utf-8"), str(_SRC), "exec"))  # noqa: S102
+_NAMES = ("_events.py", "_linalg.py", "_kernel.py", "_exact_modes.py", "_exact_config.py",
+          "_kernel_exact.py")
+
+
+def _combined_source() -> Path:
+    here = Path(__file__).parent
+    parts = [f"# ---- {n}\n" + here.joinpath(n).read_text(encoding="utf-8") for n in _NAMES]
+    text = "\n".join(parts)
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+    for folder in (here / "__pycache__", Path(tempfile.gettempdir()) / "seisrack-kernels"):
+        path = folder / f"_kernels_{digest}.py"
+        try:
+            if not path.exists() or path.read_text(encoding="utf-8") != text:
+                folder.mkdir(parents=True, exist_ok=True)
+                tmp = path.with_suffix(f".{id(text)}.tmp")
+                tmp.write_text(text, encoding="utf-8")
+                tmp.replace(path)
+            return path
+        except OSError:
+            continue
+    raise OSError("seisrack: no writable place for the compiled kernels' source")
+
+
+_SRC = _combined_source()
+exec(compile(_SRC.read_text(encoding="utf-8"), str(_SRC), "exec"))  # noqa: S102
