@@ -217,15 +217,20 @@ def _hyst_env_neg(par, u):
 def _hyst_path_eval(pu, pf, u):
     """Moment and slope on the 4-point unload–reload path ``pu``, ``pf`` (increasing ``pu``):
     the segment whose start is the last point at or left of ``u``; the end segments extend
-    linearly beyond the path's ends."""
+    linearly beyond the path's ends.
+
+    Deliberate difference from OpenSees' Pinching4: there a segment of exactly zero slope is
+    replaced by the last segment extrapolated backwards (its ``k == 0`` test doubles as "no
+    segment found"), which makes the moment jump, e.g. on the flat plateau of rForceP = uForceP
+    = 0. Here a flat segment is flat; and a last segment of zero length (reload point on the
+    target point, rDisp = rForce = 1) is skipped instead of giving 0/0."""
     j = 0
     for i in range(3):
         if u >= pu[i]:
             j = i
+    if j == 2 and not pu[3] > pu[2]:
+        j = 1
     s = _hyst_div(pf[j + 1] - pf[j], pu[j + 1] - pu[j])
-    if s == 0.0:  # a flat segment: OpenSees falls back to the first or last segment
-        j = 0 if u < pu[0] else 2
-        s = _hyst_div(pf[j + 1] - pf[j], pu[j + 1] - pu[j])
     return pf[j] + (u - pu[j]) * s, s
 
 
