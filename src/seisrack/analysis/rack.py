@@ -16,6 +16,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from seisrack.analysis.hinges import hinge_response, rack_hinges
 from seisrack.analysis.peaks import (
     PeakTracker,
     RackOperators,
@@ -30,6 +31,7 @@ from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack A
 )
 from seisrack.dynamics import Sliders, TimeHistory, simulate
 from seisrack.dynamics.basis import Basis
+from seisrack.dynamics.hinges import Hinges
 from seisrack.errors import InputError, SolverError
 from seisrack.model.frame_model import FrameModel
 from seisrack.motion.records import Record
@@ -144,14 +146,16 @@ def run_rack(
     ag = _resample(ag_rec, k)
     av = None if av_rec is None else _resample(av_rec, k)
     sliders = Sliders(
-        model.pallet_dof, model.pallet_mass, model.pallet_mu_static, model.pallet_mu_dynamic
+        model.pallet_dof, model.pallet_mass, model.pallet_mu_static, model.pallet_mu_dynamic,
+        0.0 if model.pallet_friction_rate is None else model.pallet_friction_rate,
     )
+    hinges = rack_hinges(model)
     mats = (model.M_sparse, model.C_sparse, model.K_sparse)
     common = dict(dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
                   vertical_influence=None if av is None else model.r_y, g=model.g,
                   backend=backend, throw=throw, method=method)
     # the basis is built once and shared with the companion run
-    bas = basis if isinstance(basis, Basis) else rack_basis(model, sliders, basis, av)
+    bas = basis if isinstance(basis, Basis) else rack_basis(model, sliders, basis, av, hinges)
     level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
     pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
     P = bas.phi[model.pallet_dof, :]  # (m, r) support of each pallet
@@ -164,13 +168,13 @@ def run_rack(
         ops = operators
     # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
     # engine takes Newmark for a rack exactly when asked or when the damping has a mass term
-    newmark = method == "newmark" or (
+    newmark = method == "newmark" or hinges is not None or sliders.velocity_dependent or (
         method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
     tracker = PeakTracker(ops, P, pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
     hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
                     save_every=save_every, on_chunk=tracker, track_energy=track_energy,
-                    max_memory=max_memory)
+                    max_memory=max_memory, hinges=hinges)
     if (hist.method == "newmark") != newmark:  # pragma: no cover - guards the rule above
         raise SolverError(f"run_rack expected the {'newmark' if newmark else 'exact'} "
                           f"method but the engine used {hist.method}")
@@ -185,12 +189,13 @@ def run_rack(
         rigid_sl = Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU)
         common["method"] = "exact" if hist.method == "exact" else method
         simulate(*mats, rigid_sl, **common, basis=bas, save_every=None, on_chunk=rig,
-                 track_energy=False)
+                 track_energy=False, hinges=hinges)
         rigid_peak = rig.result()["beam_acceleration"]
     resp = _response(model, hist, ag, h, record.name, rigid_peak, ops, pallet_level, peaks)
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
-                   beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx])
+                   beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx],
+                   hinges=hinge_response(model, hist))
 
 
 def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
@@ -225,17 +230,24 @@ def pallet_bays(model: FrameModel) -> np.ndarray:
     return np.clip(np.searchsorted(ux, x, side="right") - 1, 0, max(ux.size - 2, 0))
 
 
-def rack_basis(model: FrameModel, sliders: Sliders, basis: str, av=None) -> Basis:  # noqa: ANN001
+def rack_basis(model: FrameModel, sliders: Sliders, basis: str, av=None,  # noqa: ANN001
+               hinges: Hinges | None = None) -> Basis:
+    """The run's basis: every mode up to the engine's ``AUTO_FULL_MAX_DOF`` (more with
+    nonlinear hinges), else the load-dependent Ritz basis of the ground load, the pallets and
+    (with nonlinear hinges) unit moments at the hinges."""
     from seisrack.dynamics.basis import full_basis, reduced_basis
-    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF
+    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF, AUTO_FULL_MAX_DOF_HINGES
 
     if basis not in ("auto", "full", "reduced"):
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    if basis == "full" or (basis == "auto" and model.n_dof <= AUTO_FULL_MAX_DOF):
+    full_max = AUTO_FULL_MAX_DOF if hinges is None else AUTO_FULL_MAX_DOF_HINGES
+    if basis == "full" or (basis == "auto" and model.n_dof <= full_max):
         return full_basis(model.M_sparse, model.K_sparse)
     loads = [model.total_mass_sparse() @ model.r_x]
     if av is not None:
         loads.append(model.M_sparse @ model.r_y)
+    if hinges is not None:
+        loads.append(hinges.load_vectors(model.n_dof)[:, hinges.law != 0])
     return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
                          np.column_stack(loads))
 

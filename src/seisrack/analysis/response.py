@@ -84,6 +84,7 @@ class RackResponse:
     beam_acceleration_filtered: np.ndarray | None = None
     acceleration_filter_hz: float = ACCEL_FILTER_HZ
     operators: Any = field(default=None, repr=False)
+    hinges: Any = None  # HingeResponse (analysis.hinges) with nonlinear connections
 
     # ------------------------------------------------------------------ derived results
     @property

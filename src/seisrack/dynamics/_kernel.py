@@ -29,12 +29,12 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_events.py``
     _record_events  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._contact import _accel_fixed, _consistent, _stuck_index
     from seisrack.dynamics._events import (
         _JIT,
         STATUS_OK,
         STATUS_SUBSTEP_LIMIT,
         _accept_trial,
-        _apply_candidates,
         _bracket_end,
         _bracket_start,
         _classify,
@@ -45,24 +45,18 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _interp,
         _propose,
         _record_events,
-        _release_worst,
         _sample,
         _substep_end,
         _write_output,
     )
+    from seisrack.dynamics._kernel_hinge import (
+        _hinge_commit,
+        _hinge_state,
+        _minus_qtz,
+        _mu_now,
+        _nl_trial,
+    )
     from seisrack.dynamics._linalg import _damp_mul, _hmat_pt, _mm_pt, _modal_solve, _mv, _solve
-
-
-@_JIT
-def _stuck_index(stuck, n_stuck):
-    """Indices of the ``n_stuck`` stuck sliders."""
-    idx = np.empty(n_stuck, dtype=np.int64)
-    k = 0
-    for j in range(stuck.shape[0]):
-        if stuck[j]:
-            idx[k] = j
-            k += 1
-    return idx
 
 
 @_JIT
@@ -147,106 +141,68 @@ def _trial(
 
 
 @_JIT
-def _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag, pext, lam, qdd, wdd):
-    """Accelerations from equilibrium for given slider forces ``lam``."""
-    n = kd.shape[0]
-    m = mass.shape[0]
-    _damp_mul(cd, Cq, diag, qd, qdd)
-    for i in range(n):
-        acc = pext[i] - qdd[i] - kd[i] * q[i]
-        for j in range(m):
-            acc -= P[j, i] * lam[j]
-        qdd[i] = acc
-    for j in range(m):
-        wdd[j] = -ag + lam[j] / mass[j]
-
-
-@_JIT
-def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuck, sig,
-                cand, forced, qdd, wdd, lam):
-    """Decide the contact state at an instant and compute consistent accelerations.
-
-    ``cand``: sliders at zero relative velocity whose state must be decided (stick if the force
-    needed to keep them stuck is within mu_s N, else slide opposite to that force).
-    ``forced``: sliders that must slide with the given ``sig`` (slip onset just located).
-    Updates ``stuck`` and ``sig`` in place; writes accelerations ``qdd``, ``wdd`` and ``lam``.
-    """
-    n = kd.shape[0]
-    m = mass.shape[0]
-    tmp = np.empty(n)
-    _damp_mul(cd, Cq, diag, qd, tmp)
-    base = np.empty(n)  # structural acceleration without slider forces
-    for i in range(n):
-        base[i] = pext[i] - tmp[i] - kd[i] * q[i]
-    pb = np.empty(m)
-    _mv(P, base, pb)
-    sdot0 = np.empty(m)
-    for j in range(m):
-        sdot0[j] = -ag - pb[j]
-    _apply_candidates(cand, forced, stuck)
-    for _it in range(2 * m + 2):
-        n_stuck = 0
-        for j in range(m):
-            if stuck[j]:
-                n_stuck += 1
-            else:
-                lam[j] = -mud[j] * N[j] * sig[j]
-        if n_stuck > 0:
-            idx = _stuck_index(stuck, n_stuck)
-            Bss = np.empty((n_stuck, n_stuck))
-            r = np.empty(n_stuck)
-            for a in range(n_stuck):
-                acc = sdot0[idx[a]]
-                for j in range(m):
-                    if not stuck[j]:
-                        acc += B[idx[a], j] * lam[j]
-                r[a] = -acc
-                for c in range(n_stuck):
-                    Bss[a, c] = B[idx[a], idx[c]]
-            x = _solve(Bss, r.reshape((n_stuck, 1)))[:, 0]
-            for a in range(n_stuck):
-                lam[idx[a]] = x[a]
-        # release the most overloaded stuck slider, one at a time
-        if _release_worst(stuck, forced, lam, mus, N, sig) < 0:
-            break
-    ptl = np.empty(n)
-    _mv(np.ascontiguousarray(P.T), lam, ptl)
-    for i in range(n):
-        qdd[i] = base[i] - ptl[i]
-    for j in range(m):
-        wdd[j] = -ag + lam[j] / mass[j]
+def _any_trial(
+    nl, h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar, hst, hst_t,
+    hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N1, stuck, sig, Ainv, cache_ok,
+    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
+):
+    """The trial step of either path: linear (``_trial``; ``D`` = P) or nonlinear
+    (``_nl_trial``: hinges and velocity-dependent friction, ``D`` = [P; Q]).
+    Returns (recomputed Ainv, status)."""
+    if nl:
+        hz_t[:] = hz
+        st = _nl_trial(h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar,
+                       hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N1, stuck, sig,
+                       q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t)
+        return False, st
+    rec = _trial(h, kd, cd, Cq, diag, D, HDt, GG, mass, mud, q, qd, qdd, w, wd, wdd, ag1, pe1,
+                 N1, stuck, sig, Ainv, cache_ok, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1,
+                 wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
+    return rec, STATUS_OK
 
 
 @_JIT
 def run_kernel(
-    kd, cd, Cq, diag, P, mass, mus, mud, dt, ag, pext, N, q_init, qd_init,
-    resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
+    kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hk, hlaw, hpar, hst, dt, ag, pext, N,
+    q_init, qd_init, resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
     track_energy, max_events, max_substeps,
-    out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy,
+    out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy, out_hm,
     ev_time, ev_slider, ev_kind,
 ):
     """Integrate ``n_steps = ag.shape[0] - 1`` steps. Returns (status, n_events, n_substeps).
 
     Resumable: with ``resume`` the sliders start from ``w_state, wd_state, stuck_state,
-    sig_state`` and the cumulative energies from ``e_state`` (input, damping, friction);
-    otherwise they start stuck on their supports. On return these arrays hold the final state,
-    so a long run can be split into chunks (for progress reporting) without changing the result.
+    sig_state``, the cumulative energies from ``e_state`` (input, damping, friction, hinge
+    correction work) and the hinges from their committed states ``hst``; otherwise the sliders
+    start stuck on their supports. On return these arrays hold the final state, so a long run
+    can be split into chunks (for progress reporting) without changing the result.
     ``t_offset`` [s] is added to event times.
 
     ag: (n_t,) ground acceleration at grid points; pext: (n_t, n) modal external load
     (``Φ^T (F - M r a_g)``); N: (n_t, m) normal force of each slider.
-    out_energy columns: input, kinetic, strain, damping, friction dissipation (cumulative).
+    rate: (m,) velocity-dependence of friction [s/m] (0: Coulomb). Hinges (``_kernel_hinge``):
+    Q (n_h, n) rotations of the basis coordinates, hk (n_h,) elastic stiffness, hlaw, hpar,
+    hst (n_h, HYST_NSTATE) law, parameters and committed state; out_hm (n_t, n_h) moments.
+    out_energy columns: input, kinetic, strain (with the hinges' correction work, so that the
+    column is the structure's whole internal work), damping, friction dissipation (cumulative).
     """
     n = kd.shape[0]
     m = mass.shape[0]
+    nh = hk.shape[0]
     n_t = ag.shape[0]
+    nl = nh > 0
+    for j in range(m):
+        if rate[j] > 0.0:
+            nl = True
+    D = np.empty((m + nh, n))  # [P; Q]: P alone on the linear path
+    D[:m] = P
+    D[m:] = Q
     # operators for the regular step
-    HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, P)
-    G_dt = _mm_pt(P, np.ascontiguousarray(HPt_dt.T))
+    HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, D)
+    G_dt = _mm_pt(D, np.ascontiguousarray(HPt_dt.T))
     B = _mm_pt(P, P)
     for j in range(m):
         B[j, j] += 1.0 / mass[j]
-    # state
     # state at the start of the (sub)step: T0 rows q, qd, qdd; S0 rows w, wd, lam, s, wdd
     T0 = np.zeros((3, n))
     T0[0] = q_init
@@ -255,7 +211,16 @@ def run_kernel(
     S0, stuck, sig, cand, forced, E_in, E_damp, E_fric = _init_sliders(
         5, resume, P, q, qd, w_state, wd_state, stuck_state, sig_state, e_state)
     w, wd, lam, s0, wdd = S0[0], S0[1], S0[2], S0[3], S0[4]
-    _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag[0], pext[0], N[0],
+    E_z = e_state[3] if resume else 0.0
+    Wh = np.zeros((4, nh))  # hinge moments, corrections (committed), and trial copies
+    hM, hz, hM_t, hz_t = Wh[0], Wh[1], Wh[2], Wh[3]
+    hst_t = hst.copy()
+    _hinge_state(Q, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
+    mu_now = mud.copy()
+    pe_eff = np.empty(n)
+    _mu_now(mus, mud, rate, stuck, s0, mu_now)
+    _minus_qtz(pext[0], Q, hz, pe_eff)
+    _consistent(kd, cd, Cq, diag, P, B, mass, mus, mu_now, q, qd, ag[0], pe_eff, N[0],
                 stuck, sig, cand, forced, qdd, wdd, lam)
     n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
                           ev_time, ev_slider, ev_kind)
@@ -275,6 +240,8 @@ def run_kernel(
 
     _write_output(0, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy, E_in, E_damp,
                   E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
+    out_energy[0, 2] += E_z
+    out_hm[0, :] = hM
     for step in range(n_t - 1):
         tau = 0.0  # fraction of the step already integrated
         n_sub = 0  # sub-steps taken in this step
@@ -289,22 +256,20 @@ def run_kernel(
                 pe1[i] = pext[step + 1, i]
             ag1 = ag[step + 1]
             if full:
-                recomputed = _trial(
-                    dt, kd, cd, Cq, diag, P, HPt_dt, G_dt, mass, mud, q, qd, qdd, w, wd, wdd,
-                    ag1, pe1, N[step + 1], stuck, sig, Ainv, cache_ok,
-                    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
-                )
-                if recomputed:
-                    cache_ok = True
+                HPt, G = HPt_dt, G_dt
             else:
-                HPt = _hmat_pt(kd, cd, Cq, diag, hrem, P)
-                G = _mm_pt(P, np.ascontiguousarray(HPt.T))
-                _trial(
-                    hrem, kd, cd, Cq, diag, P, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd,
-                    ag1, pe1, N[step + 1], stuck, sig, Ainv, False,
-                    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
-                )
-                cache_ok = False
+                HPt = _hmat_pt(kd, cd, Cq, diag, hrem, D)
+                G = _mm_pt(D, np.ascontiguousarray(HPt.T))
+            use_cache = cache_ok and full
+            recomputed, st_tr = _any_trial(
+                nl, hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw, hpar,
+                hst, hst_t, hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
+                stuck, sig, Ainv, use_cache, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1,
+                wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
+            cache_ok = (cache_ok or recomputed) and full
+            if st_tr != STATUS_OK:
+                status = st_tr
+                break
             any_ev = _detect(stuck, sig, mus, mud, mass, N[step], N[step + 1], lam1, wd1, s1,
                              dt, tolF, e_hi)
             theta_hi = 1.0  # fraction of the remaining sub-step
@@ -320,16 +285,21 @@ def run_kernel(
                         break
                     ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
                     hsub = th * hrem
-                    HPt = _hmat_pt(kd, cd, Cq, diag, hsub, P)
-                    G = _mm_pt(P, np.ascontiguousarray(HPt.T))
-                    _trial(
-                        hsub, kd, cd, Cq, diag, P, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd,
-                        ag_e, tmpn, N_e, stuck, sig, Ainv, False,
-                        q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
-                    )
+                    HPt = _hmat_pt(kd, cd, Cq, diag, hsub, D)
+                    G = _mm_pt(D, np.ascontiguousarray(HPt.T))
+                    _rec, st_tr = _any_trial(
+                        nl, hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw,
+                        hpar, hst, hst_t, hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag_e,
+                        tmpn, N_e, stuck, sig, Ainv, False, q1, qd1, qdd1, w1, wd1, wdd1, lam1,
+                        s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
                     cache_ok = False
+                    if st_tr != STATUS_OK:
+                        status = st_tr
+                        break
                     _accept_trial(br, th, stuck, sig, lam1, N_e, s1, mus, tolF, e_try,
                                   e_lo, e_hi, T1, S1, Tb, Sb)
+                if status != STATUS_OK:
+                    break
                 theta_hi = _bracket_end(br, T1, S1, Tb, Sb)
             # --- accept the sub-step [tau, tau_end]
             tau_end = _substep_end(tau, theta_hi, any_ev)
@@ -359,23 +329,26 @@ def run_kernel(
                     E_fric -= 0.5 * (lam[j] + lam1[j]) * (dwj - wk_v[j])
                 E_in += dq_in
                 E_damp += dd
+            if nh > 0:
+                E_z += _hinge_commit(Q, hk, hlaw, hpar, hst, hst_t, q, q1, hM, hz)
             T0[:] = T1
             S0[:] = S1
             if tau_end >= 1.0:
                 if not full:
                     # a short final sub-step amplifies round-off in the Newmark acceleration
                     # update; restore accelerations from equilibrium (same forces lam)
-                    for i in range(n):
-                        tmpn[i] = pext[step + 1, i]
+                    _minus_qtz(pext[step + 1], Q, hz, tmpn)
                     _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag[step + 1], tmpn, lam,
                                  qdd, wdd)
                 break
             # --- transition at t_e = (step + tau_end) dt (§5)
             ag_e = _sample(ag, pext, N, step, tau_end, tmpn, N_e)
+            _minus_qtz(tmpn, Q, hz, tmpn)
             _mv(P, qd, vn0)
             _classify(stuck, sig, lam, s1, wd, vn0, mus, N_e, tolF, e_try, old_stuck, old_sig,
                       cand, forced)
-            _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag_e, tmpn, N_e,
+            _mu_now(mus, mud, rate, stuck, s0, mu_now)
+            _consistent(kd, cd, Cq, diag, P, B, mass, mus, mu_now, q, qd, ag_e, tmpn, N_e,
                         stuck, sig, cand, forced, qdd, wdd, lam)
             cache_ok = False
             n_ev = _record_events(old_stuck, old_sig, stuck, sig,
@@ -387,8 +360,11 @@ def run_kernel(
         status = _write_output(step + 1, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy,
                                E_in, E_damp, E_fric, out_q, out_qd, out_qdd, out_w, out_wd,
                                out_lam, out_stuck, out_energy)
+        out_energy[step + 1, 2] += E_z
+        out_hm[step + 1, :] = hM
         if status != STATUS_OK:
             break
     status = _finish(status, n_ev, max_events, w, wd, stuck, sig, E_in, E_damp, E_fric,
                      w_state, wd_state, stuck_state, sig_state, e_state)
+    e_state[3] = E_z
     return status, n_ev, n_sub_total

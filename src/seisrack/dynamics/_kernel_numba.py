@@ -1,11 +1,12 @@
-"""numba-compiled build of ``_hysteresis.py``, ``_events.py``, ``_linalg.py``, ``_kernel.py``,
-``_exact_modes.py``, ``_exact_config.py`` and ``_kernel_exact.py`` (the same sources, executed in this order with
-``_JIT = njit`` in one namespace).
+"""numba-compiled build of ``_hysteresis.py``, ``_events.py``, ``_linalg.py``, ``_contact.py``,
+``_kernel_hinge.py``, ``_kernel.py``, ``_exact_modes.py``, ``_exact_config.py`` and
+``_kernel_exact.py`` (the same sources, executed in this order with ``_JIT = njit`` in one
+namespace).
 
 numba's on-disk cache keys each function on the timestamp of *its own* source file, while a
 compiled caller embeds the code of the callees it uses from the other files: after an edit of
 ``_exact_modes.py`` alone, ``run_kernel_exact`` would load from the cache with the old callees.
-So the seven sources are concatenated into one file named by the hash of their content
+So the sources are concatenated into one file named by the hash of their content
 (``__pycache__/_kernels_<hash>.py``, or the temporary folder when the package is read-only),
 and compiled from there: any edit of any of them gives a new file and a fresh cache.
 """
@@ -17,8 +18,8 @@ from pathlib import Path
 import numba
 
 _JIT = numba.njit(cache=True)
-_NAMES = ("_hysteresis.py", "_events.py", "_linalg.py", "_kernel.py", "_exact_modes.py",
-          "_exact_config.py", "_kernel_exact.py")
+_NAMES = ("_hysteresis.py", "_events.py", "_linalg.py", "_contact.py", "_kernel_hinge.py",
+          "_kernel.py", "_exact_modes.py", "_exact_config.py", "_kernel_exact.py")
 
 
 def _combined_source() -> Path:

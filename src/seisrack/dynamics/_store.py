@@ -8,11 +8,11 @@ import numpy as np
 class Buffers:
     """Kernel output buffers for one chunk (reused)."""
 
-    def __init__(self, rows: int, nb: int, m: int) -> None:
+    def __init__(self, rows: int, nb: int, m: int, nh: int = 0) -> None:
         self.arrays = (
             np.empty((rows, nb)), np.empty((rows, nb)), np.empty((rows, nb)),
             np.empty((rows, m)), np.empty((rows, m)), np.empty((rows, m)),
-            np.empty((rows, m), dtype=np.bool_), np.zeros((rows, 5)),
+            np.empty((rows, m), dtype=np.bool_), np.zeros((rows, 5)), np.zeros((rows, nh)),
         )
 
     def views(self, k: int) -> tuple[np.ndarray, ...]:
@@ -22,7 +22,7 @@ class Buffers:
 class Kept:
     """The samples a run keeps: every ``save_every``-th step and the last one."""
 
-    def __init__(self, n_keep: int, nb: int, m: int, energy: bool) -> None:
+    def __init__(self, n_keep: int, nb: int, m: int, energy: bool, nh: int = 0) -> None:
         self.q = np.empty((n_keep, nb))
         self.qd = np.empty((n_keep, nb))
         self.qdd = np.empty((n_keep, nb))
@@ -31,6 +31,7 @@ class Kept:
         self.lam = np.empty((n_keep, m))
         self.stuck = np.empty((n_keep, m), dtype=np.bool_)
         self.energy = np.zeros((n_keep, 5))
+        self.hm = np.zeros((n_keep, nh))
         self.N = np.empty((n_keep, m))
         self.idx = np.empty(n_keep, dtype=np.int64)
         self.count = 0
@@ -47,7 +48,8 @@ class Kept:
         loc = sel - start
         a, b = self.count, self.count + sel.size
         for dst, src in zip(
-            (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck, self.energy),
+            (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck, self.energy,
+             self.hm),
             outs, strict=True,
         ):
             dst[a:b] = src[loc]
@@ -58,4 +60,4 @@ class Kept:
     def result(self) -> tuple[np.ndarray, ...]:
         c = self.count
         return (self.q[:c], self.qd[:c], self.qdd[:c], self.w[:c], self.wd[:c], self.lam[:c],
-                self.stuck[:c], self.energy[:c], self.N[:c], self.idx[:c])
+                self.stuck[:c], self.energy[:c], self.hm[:c], self.N[:c], self.idx[:c])

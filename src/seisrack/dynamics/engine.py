@@ -23,6 +23,7 @@ from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._store import Buffers as _Buffers
 from seisrack.dynamics._store import Kept as _Kept
 from seisrack.dynamics.basis import Basis, full_basis, reduced_basis
+from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import get_kernel
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
 from seisrack.dynamics.sliders import Sliders
@@ -35,6 +36,9 @@ _LOG = logging.getLogger(__name__)
 _MAX_SUBSTEPS = 512
 #: with ``basis="auto"``, structures up to this many DOFs keep every mode
 AUTO_FULL_MAX_DOF = 50
+#: with nonlinear hinges, ``basis="auto"`` keeps every mode up to this many DOFs (the elastic
+#: modes of a yielding frame are not its modes; above, the Ritz basis gets the hinge vectors)
+AUTO_FULL_MAX_DOF_HINGES = 1500
 #: default cap on what one run's kept histories and buffers may take [bytes]
 DEFAULT_MAX_MEMORY = 4 * 2**30
 #: steps integrated per kernel call (bounded working memory; the state carries over exactly)
@@ -45,6 +49,7 @@ _STATUS = {
     1: "event buffer overflow (increase max_events)",
     2: "too many events inside one step (reduce dt)",
     3: "non-finite response (check the input)",
+    4: "hinge equilibrium iterations did not converge (reduce dt)",
 }
 
 
@@ -52,7 +57,8 @@ class Chunk(NamedTuple):
     """Full-rate results of one chunk of steps, handed to ``on_chunk`` (views: copy to keep).
 
     t: (k,) [s]; q, qd, qdd: (k, r) basis coordinates; slider_u, slider_v, friction: (k, m);
-    stuck: (k, m) bool. Consecutive chunks share their boundary sample.
+    stuck: (k, m) bool; hinge_moment: (k, n_h) [N·m] (n_h = 0 without nonlinear hinges).
+    Consecutive chunks share their boundary sample.
     """
 
     t: np.ndarray
@@ -63,6 +69,7 @@ class Chunk(NamedTuple):
     slider_v: np.ndarray
     friction: np.ndarray
     stuck: np.ndarray
+    hinge_moment: np.ndarray
 
 
 def modal_basis(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # noqa: N803
@@ -98,6 +105,7 @@ def simulate(
     save_every: int | None = 1,
     on_chunk: Callable[[Chunk], None] | None = None,
     max_memory: float | None = None,
+    hinges: Hinges | None = None,
 ) -> TimeHistory:
     """Time history of a linear structure carrying masses that may stick or slide.
 
@@ -134,6 +142,10 @@ def simulate(
         streaming without keeping the histories).
     max_memory : bytes the kept histories and buffers may use (default: half of the memory
         available now, at most 4 GiB); a larger run is refused before anything is allocated.
+    hinges : rotational springs of K whose moment follows a hysteresis law
+        (:class:`~seisrack.dynamics.hinges.Hinges`); with a nonlinear law, or sliders with
+        velocity-dependent friction, the run takes the Newmark path with equilibrium
+        iterations inside the step (``docs/theory/nonlinear_hinges.md``).
     """
     M = chk.square("M", M, None)
     n = M.shape[0]
@@ -181,14 +193,20 @@ def simulate(
     if method not in ("auto", "exact", "newmark"):
         raise InputError("method", method, '"auto", "exact" or "newmark"')
     m = sliders.count
+    if hinges is None:
+        hinges = no_hinges()
+    if not isinstance(hinges, Hinges):
+        raise InputError("hinges", type(hinges).__name__, "a seisrack.dynamics.hinges.Hinges")
+    hinges.check(n)
+    nonlinear = hinges.nonlinear or sliders.velocity_dependent
     chunk = int(chunk_steps or (2000 if progress is not None else DEFAULT_CHUNK))
     chunk = min(chunk, n_steps)
 
-    bas = _choose_basis(basis, M, K, sliders, r, rv, F)
+    bas = _choose_basis(basis, M, K, sliders, r, rv, F, hinges)
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
     n_keep = _kept_samples(n_steps, save_every)
-    _check_memory(n_keep, chunk, nb, m, n_t, max_memory)
+    _check_memory(n_keep, chunk, nb, m + hinges.count, n_t, max_memory)
 
     cq = phi.T @ (C @ phi)
     off = cq - np.diag(np.diag(cq))
@@ -204,7 +222,9 @@ def simulate(
     q0 = phi.T @ (M @ q_u0)  # Φ is M-orthonormal: q = Φᵀ M u
     qd0 = phi.T @ (M @ q_v0)
 
-    why_not = _exact_unsupported(w2, cd, diag, sliders.dof)
+    why_not = _exact_unsupported(w2, cd, diag, sliders.dof) or (
+        "nonlinear hinges or velocity-dependent friction need equilibrium iterations"
+        if nonlinear else "")
     if method == "exact" and why_not:
         raise InputError("method", method, f'"newmark" or "auto" here: {why_not}')
     use_exact = method != "newmark" and not why_not
@@ -218,8 +238,13 @@ def simulate(
     ag = chk.writable(ag)
     pat = chk.writable(pat)
 
-    buf = _Buffers(chunk + 1, nb, m)
-    keep = _Kept(n_keep, nb, m, track_energy)
+    nh = hinges.count if hinges.nonlinear else 0
+    Q = hinges.operator(phi)[:nh]
+    hst = hinges.initial_state()[:nh]
+    h_k, h_law, h_par = hinges.k[:nh], hinges.law[:nh], hinges.par[:nh]
+    rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
+    buf = _Buffers(chunk + 1, nb, m, nh)
+    keep = _Kept(n_keep, nb, m, track_energy, nh)
     ev_time = np.empty(max_events + 1)
     ev_slider = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
@@ -227,7 +252,7 @@ def simulate(
     wd_state = np.zeros(m)
     stuck_state = np.ones(m, dtype=np.bool_)
     sig_state = np.ones(m)
-    e_state = np.zeros(3)
+    e_state = np.zeros(4)
     status, n_ev, n_sub, n_cfg = 0, 0, 0, 0
     if use_exact:
         a1 = _stiffness_proportional(w2, cd)
@@ -255,12 +280,13 @@ def simulate(
                     ag[rows], pext, pat, ser, N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
-                    *outs, *ev,
+                    *outs[:8], *ev,
                 )
                 n_cfg += int(nc)
             else:
                 st, ne, ns = kern.run_kernel(
-                    w2c, cd, Cq, diag, P, mass, mus, mud, float(dt), ag[rows], pext, N, qs, qds,
+                    w2c, cd, Cq, diag, P, mass, mus, mud, rate, Q, h_k, h_law, h_par, hst,
+                    float(dt), ag[rows], pext, N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
                 )
@@ -269,7 +295,7 @@ def simulate(
             status = int(st)
             t_chunk = np.arange(start, stop + 1) * dt
             if on_chunk is not None:
-                on_chunk(Chunk(t_chunk, *outs[:7]))
+                on_chunk(Chunk(t_chunk, *outs[:7], outs[8]))
             keep.take(start, stop, n_steps, save_every, outs, N)
             qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
             if status != 0:
@@ -291,11 +317,14 @@ def simulate(
         Event(float(ev_time[k]), int(ev_slider[k]), EVENT_KINDS[int(ev_kind[k])])
         for k in range(n_keep_ev)
     ]
-    kq, kqd, kqdd, kw, kwd, klam, kst, ken, kN, kidx = keep.result()
+    kq, kqd, kqdd, kw, kwd, klam, kst, ken, khm, kN, kidx = keep.result()
     energy = {}
     if track_energy:
         names = ("input", "kinetic", "strain", "damping", "friction")
         energy = {nm: ken[:, c].copy() for c, nm in enumerate(names)}
+        if nh:
+            energy["strain"], energy["hysteresis"] = energy_split(
+                energy["strain"], kq, w2, kq @ Q.T, khm, h_k)
     return TimeHistory(
         t=kidx * dt,
         q=kq,
@@ -318,6 +347,8 @@ def simulate(
         n_configurations=int(n_cfg),
         basis=bas.describe(),
         sample_index=kidx,
+        hinge_moment=khm,
+        hinge_operator=Q,
     )
 
 
@@ -332,7 +363,7 @@ def _blas_controller() -> ThreadpoolController:
     return _CONTROLLER[0]
 
 
-def _choose_basis(basis, M, K, sliders, r, rv, F) -> Basis:  # noqa: ANN001, N803
+def _choose_basis(basis, M, K, sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN001, N803
     n = M.shape[0]
     if isinstance(basis, Basis):
         if basis.phi.shape[0] != n:
@@ -340,7 +371,8 @@ def _choose_basis(basis, M, K, sliders, r, rv, F) -> Basis:  # noqa: ANN001, N80
         return basis
     if basis not in ("auto", "full", "reduced"):
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
+    full_max = AUTO_FULL_MAX_DOF_HINGES if hinges.nonlinear else AUTO_FULL_MAX_DOF
+    if basis == "full" or (basis == "auto" and n <= full_max):
         return full_basis(M, K)
     on = sliders.dof >= 0
     extra = np.zeros(n)
@@ -355,6 +387,8 @@ def _choose_basis(basis, M, K, sliders, r, rv, F) -> Basis:  # noqa: ANN001, N80
                 e = np.zeros(n)
                 e[d] = 1.0
                 loads.append(e)
+    if hinges.nonlinear:
+        loads.append(hinges.load_vectors(n)[:, hinges.law != 0])
     return reduced_basis(M, K, sliders.dof, sliders.mass, np.column_stack(loads))
 
 

@@ -30,7 +30,9 @@ class TimeHistory:
     sliding: (n_t, m) [m] slider displacement relative to its support node;
     friction: (n_t, m) [N] horizontal force of the structure on each slider;
     normal: (n_t, m) [N] normal force; stuck: (n_t, m) bool;
-    energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction.
+    energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction, and with
+    nonlinear hinges "hysteresis" (their dissipated work; "strain" is then the recoverable part);
+    hinge_moment: (n_t, n_h) [N·m] and :attr:`hinge_rotation` of the nonlinear hinges.
     Here ``n_t`` counts the *kept* samples: with ``simulate(save_every=k)`` they are the steps
     listed in ``sample_index`` (every k-th and the last), at times ``t``. ``basis`` describes
     the basis ``phi`` (full, or reduced with its cut-off), see :mod:`seisrack.dynamics.basis`.
@@ -57,6 +59,15 @@ class TimeHistory:
     n_configurations: int = 0
     basis: dict = field(default_factory=dict)
     sample_index: np.ndarray | None = None
+    hinge_moment: np.ndarray | None = None
+    hinge_operator: np.ndarray | None = None
+
+    @property
+    def hinge_rotation(self) -> np.ndarray | None:
+        """(n_t, n_h) [rad] rotation of each nonlinear hinge (None without them)."""
+        if self.hinge_operator is None:
+            return None
+        return self.q @ self.hinge_operator.T
 
     @cached_property
     def u(self) -> np.ndarray:
@@ -102,12 +113,14 @@ class TimeHistory:
             + (e["strain"] - e["strain"][0])
             + e["damping"]
             + e["friction"]
+            + e.get("hysteresis", 0.0)
         )
         scale = max(
             float(np.max(np.abs(e["input"]))),
             float(np.max(e["kinetic"])),
             float(np.max(e["strain"])),
-            float(np.max(np.abs(e["damping"]))) + float(np.max(np.abs(e["friction"]))),
+            float(np.max(np.abs(e["damping"]))) + float(np.max(np.abs(e["friction"])))
+            + float(np.max(np.abs(e.get("hysteresis", 0.0)))),
             1e-300,
         )
         return float(np.max(np.abs(lhs - rhs)) / scale)

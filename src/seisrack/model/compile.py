@@ -79,7 +79,40 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         upright_below_elements=rm.upright_below_elements,
         upright_above_elements=rm.upright_above_elements,
         member_mass=member_mass, g=spec.g, title=spec.title, critical_load_factor=lam_cr,
+        **_hinges(spec, rm),
+        pallet_friction_rate=np.array([p.friction_rate for p in spec.pallets], dtype=float),
     ))
+
+
+def _hinges(spec: RackSpec, rm: RackMesh) -> dict[str, np.ndarray]:
+    """Every connection spring as a hinge, with its law (``[hysteresis]``, else elastic)."""
+    from seisrack.model.hinge_law import HingeLaw
+
+    mesh = rm.mesh
+    springs, k = mesh.springs, mesh.spring_k
+    base = springs[:, 1] < 0
+    # a connector spring is (upright rz, beam-end rz): its rotation is beam end − upright
+    dofs = np.where(base[:, None], springs, springs[:, ::-1])
+    node_of = {}
+    for node, d in enumerate(mesh.node_dofs):
+        if d[2] >= 0:
+            node_of.setdefault(int(d[2]), node)  # the upright's node owns its rotation first
+    node = np.array([node_of[int(a)] for a in springs[:, 0]], dtype=np.int64)
+    laws, pars, th_y = [], [], []
+    for kk, is_base in zip(k, base, strict=True):
+        law = spec.hysteresis.base if is_base else spec.hysteresis.beam_to_upright
+        law = law if law is not None else HingeLaw("elastic", float(kk))
+        code, par = law.pack()
+        laws.append(code)
+        pars.append(par)
+        th_y.append(law.yield_rotation)
+    from seisrack.dynamics._hysteresis import HYST_NPAR
+
+    return {"hinge_dofs": dofs.astype(np.int64).reshape(-1, 2), "hinge_k": k.astype(float),
+            "hinge_kind": base.astype(np.int64), "hinge_node": node,
+            "hinge_law": np.array(laws, dtype=np.int64),
+            "hinge_par": np.array(pars, dtype=float).reshape(-1, HYST_NPAR),
+            "hinge_yield_rotation": np.array(th_y, dtype=float)}
 
 
 def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:

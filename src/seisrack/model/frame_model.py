@@ -21,6 +21,9 @@ _DENSE_CACHE = ("K", "M", "C")
 UPRIGHT = 0
 BEAM = 1
 
+CONNECTOR = 0  # hinge_kind: beam-to-upright connector
+BASE_PLATE = 1  # hinge_kind: base plate
+
 
 @dataclass(frozen=True, eq=False)
 class FrameModel:
@@ -63,6 +66,17 @@ class FrameModel:
         member_mass: [kg] total mass of all members (including mass on restrained DOFs).
         g: [m/s²].
 
+    Hinges (every connection spring of ``mesh.springs``, connectors then base plates in mesh
+    order; see :mod:`seisrack.dynamics.hinges`):
+        hinge_dofs: (n_h, 2) int, rotation DOFs (a, b): the hinge rotation is u[a] − u[b]
+            (beam end minus upright for a connector; b = -1, the ground, for a base plate).
+        hinge_k: (n_h,) [N·m/rad] elastic stiffness (in K). hinge_kind: (n_h,) CONNECTOR or
+            BASE_PLATE. hinge_node: (n_h,) int node of the hinge (the upright's node).
+        hinge_law, hinge_par: (n_h,) int law code and (n_h, HYST_NPAR) parameters (elastic
+            where ``[hysteresis]`` gives no law).
+        hinge_yield_rotation: (n_h,) [rad] end of the elastic branch (``inf``: elastic).
+        pallet_friction_rate: (n_pallet,) [s/m] velocity dependence of friction (0: Coulomb).
+
     Second order:
         critical_load_factor: with ``[second_order] p_delta = true``, the lowest λ with
             det(K_E + λ K_G) = 0 for the gravity load (``K_sparse`` is then K_E + K_G, see
@@ -100,6 +114,19 @@ class FrameModel:
     g: float
     title: str = ""
     critical_load_factor: float | None = None
+    hinge_dofs: IntArray | None = None
+    hinge_k: FloatArray | None = None
+    hinge_kind: IntArray | None = None
+    hinge_node: IntArray | None = None
+    hinge_law: IntArray | None = None
+    hinge_par: FloatArray | None = None
+    hinge_yield_rotation: FloatArray | None = None
+    pallet_friction_rate: FloatArray | None = None
+
+    @property
+    def nonlinear_hinges(self) -> bool:
+        """True when some connection follows a nonlinear moment–rotation law."""
+        return self.hinge_law is not None and bool((self.hinge_law != 0).any())
 
     @property
     def n_dof(self) -> int:

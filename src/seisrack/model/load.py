@@ -29,6 +29,7 @@ from seisrack.model.spec import (
     Connections,
     Damping,
     Geometry,
+    Hysteresis,
     Material,
     Pallet,
     RackSpec,
@@ -37,7 +38,7 @@ from seisrack.model.spec import (
 )
 
 _TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping",
-             "second_order", "loading", "pallets")
+             "second_order", "hysteresis", "loading", "pallets")
 _LINE_RE = re.compile(r"\(at line (\d+), column (\d+)\)")
 _GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
 
@@ -73,6 +74,7 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     connections = _connections(root.table("connections"))
     damping = _damping(root.table("damping", {}))
     second_order = _second_order(root.table("second_order", {}))
+    hysteresis = _hysteresis(root.table("hysteresis", {}), connections)
     raw_pallets = root.array("pallets", [])
     explicit = tuple(
         _pallet(Table(p, f"pallets[{i}]", source), geometry) for i, p in enumerate(raw_pallets)
@@ -83,7 +85,8 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
-                    title=title, source=source, second_order=second_order)
+                    title=title, source=source, second_order=second_order,
+                    hysteresis=hysteresis)
 
 
 __all__ = ["check_friction", "load_rack", "rack_from_dict"]
@@ -223,6 +226,23 @@ def _second_order(t: Table) -> SecondOrder:
     return SecondOrder(p_delta=p_delta, form=form)  # type: ignore[arg-type]
 
 
+def _hysteresis(t: Table, connections: Connections) -> Hysteresis:
+    from seisrack.model.hinge_law import parse_hinge_law
+
+    laws = {}
+    for key in ("beam_to_upright", "base"):
+        if t.has(key):
+            laws[key] = parse_hinge_law(t.table(key).data, t.field(key),
+                                        getattr(connections, key), source=t.source)
+    t.finish(("beam_to_upright", "base"))
+    return Hysteresis(**laws)
+
+
+def friction_rate(t: Table) -> float:
+    """Optional ``friction_rate`` [s/m] (velocity-dependent friction; 0 = Coulomb)."""
+    return t.number("friction_rate", 0.0, nonnegative=True, unit="s/m")
+
+
 def _pallet(t: Table, geom: Geometry) -> Pallet:
     mass = t.number("mass", positive=True, unit="kg")
     bay = t.integer("bay")
@@ -248,10 +268,11 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
     limit_raw = t.raw("sliding_limit", None)
     limit = None if limit_raw is None else check_number(
         limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
+    rate = friction_rate(t)
     t.finish(("mass", "bay", "level", "position", "mu_static", "mu_dynamic", "width",
-              "sliding_limit"))
+              "sliding_limit", "friction_rate"))
     return Pallet(mass=mass, bay=bay, level=level, position=position, mu_static=mu_s,
-                  mu_dynamic=mu_d, width=width, sliding_limit=limit)
+                  mu_dynamic=mu_d, width=width, sliding_limit=limit, friction_rate=rate)
 
 
 def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],

@@ -31,7 +31,7 @@ from seisrack.model.spec import DEFAULT_PALLET_WIDTH, Geometry, Pallet
 MAX_PALLETS_PER_BAY = 3
 #: Keys of the ``[loading]`` table.
 LOADING_KEYS = ("pallets_per_bay", "width", "gap", "mass", "mass_per_level", "mu_static",
-                "mu_dynamic", "occupancy", "seed", "levels", "sliding_limit")
+                "mu_dynamic", "occupancy", "seed", "levels", "sliding_limit", "friction_rate")
 _GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
 
 
@@ -54,6 +54,7 @@ class Loading:
     seed: int = 0
     levels: tuple[int, ...] = ()
     sliding_limit: float | None = None
+    friction_rate: float = 0.0
 
 
 def read_loading(t: Table, geom: Geometry) -> Loading:
@@ -78,10 +79,11 @@ def read_loading(t: Table, geom: Geometry) -> Loading:
     limit_raw = t.raw("sliding_limit", None)
     limit = None if limit_raw is None else check_number(
         limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
+    rate = t.number("friction_rate", 0.0, nonnegative=True, unit="s/m")
     t.finish(LOADING_KEYS)
     return Loading(pallets_per_bay=n, width=width, gap=gap, level_mass=level_mass,
                    mu_static=mu_s, mu_dynamic=mu_d, occupancy=occupancy, seed=seed,
-                   levels=levels, sliding_limit=limit)
+                   levels=levels, sliding_limit=limit, friction_rate=rate)
 
 
 def slot_positions(loading: Loading, span: float) -> tuple[float, ...]:
@@ -119,7 +121,7 @@ def place_pallets(loading: Loading | None, geom: Geometry, explicit: Sequence[Pa
         generated.setdefault((level, bay), []).append(Pallet(
             mass=loading.level_mass[level - 1], bay=bay, level=level, position=position,
             mu_static=loading.mu_static, mu_dynamic=loading.mu_dynamic, width=loading.width,
-            sliding_limit=loading.sliding_limit))
+            sliding_limit=loading.sliding_limit, friction_rate=loading.friction_rate))
     pallets: list[Pallet] = []
     out_labels: list[str] = []
     for level in range(1, geom.n_levels + 1):

@@ -12,7 +12,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
+
+if TYPE_CHECKING:
+    from seisrack.model.hinge_law import HingeLaw
 
 #: Default pallet width along the beam [m] (EUR pallet, 1200 x 800 mm, long side across the beams).
 DEFAULT_PALLET_WIDTH = 0.8
@@ -132,12 +135,28 @@ class SecondOrder:
 
 
 @dataclass(frozen=True)
+class Hysteresis:
+    """Moment–rotation laws of the connections (``[hysteresis]``); ``None`` keeps the linear
+    spring of ``[connections]``. See :mod:`seisrack.model.hinge_law`."""
+
+    beam_to_upright: HingeLaw | None = None
+    base: HingeLaw | None = None
+
+    @property
+    def nonlinear(self) -> bool:
+        return any(x is not None and x.kind != "elastic" for x in (self.beam_to_upright,
+                                                                   self.base))
+
+
+@dataclass(frozen=True)
 class Pallet:
     """A pallet resting on the beams of one bay and level.
 
     ``bay`` and ``level`` are 1-based (as in the TOML). ``position`` [m] is the pallet centre from
     the left upright of its bay; ``width`` [m] its extent along the beam. ``sliding_limit`` [m] is
     the allowed sliding on each side, or ``None`` for the free distance to the next obstacle.
+    ``friction_rate`` [s/m]: 0 for Coulomb friction, else velocity-dependent sliding friction
+    mu(v) = mu_dynamic + (mu_static - mu_dynamic) exp(-rate |v|) (see Sliders).
     """
 
     mass: float
@@ -148,6 +167,7 @@ class Pallet:
     mu_dynamic: float
     width: float = DEFAULT_PALLET_WIDTH
     sliding_limit: float | None = None
+    friction_rate: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -164,6 +184,7 @@ class RackSpec:
     title: str = ""
     source: str | None = None
     second_order: SecondOrder = field(default_factory=SecondOrder)
+    hysteresis: Hysteresis = field(default_factory=Hysteresis)
 
     def beam_section(self, level: int) -> Section:
         """Section of the beams of 0-based ``level``."""

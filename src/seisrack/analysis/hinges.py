@@ -1,0 +1,100 @@
+"""The rack's connections as engine hinges, and their response (issue #12).
+
+Every beam-to-upright connector and semi-rigid base plate is a rotational spring of the
+compiled model (:attr:`FrameModel.hinge_dofs`). When ``[hysteresis]`` gives one of them a
+nonlinear law, the run hands them to the engine as :class:`~seisrack.dynamics.hinges.Hinges`
+and reports their rotations, moments and the hysteretic energy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seisrack.dynamics.hinges import Hinges
+from seisrack.dynamics.results import TimeHistory
+from seisrack.model.frame_model import BASE_PLATE, BEAM, FrameModel
+
+
+@dataclass(frozen=True)
+class HingeResponse:
+    """Rotations and moments of the rack's nonlinear hinges (kept samples).
+
+    labels: (n_h,) e.g. ``"connector L1 B2 left"`` (the beam of level 1, bay 2, at its left
+    end) or ``"base U3"``; kind: (n_h,) "connector" / "base"; law: (n_h,) the law's name;
+    rotation: (n_t, n_h) [rad]; moment: (n_t, n_h) [N·m]; yield_rotation: (n_h,) [rad]
+    (``inf`` for an elastic hinge).
+    """
+
+    labels: tuple[str, ...]
+    kind: tuple[str, ...]
+    law: tuple[str, ...]
+    rotation: np.ndarray
+    moment: np.ndarray
+    yield_rotation: np.ndarray
+
+    def peaks(self) -> list[dict]:
+        """Per hinge: peak |rotation|, |moment|, residual rotation, ductility demand."""
+        out = []
+        for i, lab in enumerate(self.labels):
+            th = self.rotation[:, i]
+            mom = self.moment[:, i]
+            peak = float(np.max(np.abs(th))) if th.size else 0.0
+            ty = float(self.yield_rotation[i])
+            out.append({
+                "hinge": lab, "kind": self.kind[i], "law": self.law[i],
+                "peak_rotation_rad": peak,
+                "peak_moment_Nm": float(np.max(np.abs(mom))) if mom.size else 0.0,
+                "residual_rotation_rad": float(th[-1]) if th.size else 0.0,
+                "ductility": peak / ty if np.isfinite(ty) and ty > 0 else None,
+                "yielded": bool(np.isfinite(ty) and peak > ty * (1 + 1e-9)),
+            })
+        return out
+
+
+_LAW_NAMES = {0: "elastic", 1: "elastic-plastic", 2: "bilinear", 3: "pinching"}
+
+
+def rack_hinges(model: FrameModel) -> Hinges | None:
+    """The model's connection springs as engine hinges, or None when all are elastic."""
+    if not model.nonlinear_hinges:
+        return None
+    return Hinges(model.hinge_dofs, model.hinge_k, model.hinge_law, model.hinge_par)
+
+
+def hinge_labels(model: FrameModel) -> tuple[str, ...]:
+    """A readable name per hinge: its beam (level, bay, end) or its upright (base)."""
+    assert model.hinge_dofs is not None and model.hinge_kind is not None
+    rz = model.node_dofs[:, 2]
+    el = model.elements
+    x_up = model.upright_x
+    labels = []
+    for (a, _b), kind, node in zip(model.hinge_dofs, model.hinge_kind, model.hinge_node,
+                                   strict=True):
+        col = int(np.argmin(np.abs(x_up - model.nodes[node, 0])))
+        if kind == BASE_PLATE:
+            labels.append(f"base U{col + 1}")
+            continue
+        beam_nodes = np.flatnonzero(rz == a)
+        hit = np.flatnonzero((model.element_kind == BEAM)
+                             & (np.isin(el[:, 0], beam_nodes) | np.isin(el[:, 1], beam_nodes)))
+        e = int(hit[0])
+        bay, lev = int(model.element_line[e]), int(model.element_storey[e])
+        labels.append(f"connector L{lev + 1} B{bay + 1} {'left' if col == bay else 'right'}")
+    return tuple(labels)
+
+
+def hinge_response(model: FrameModel, hist: TimeHistory) -> HingeResponse | None:
+    """The run's hinge histories (None when the run had no nonlinear hinges)."""
+    if hist.hinge_operator is None or hist.hinge_moment is None \
+            or hist.hinge_moment.shape[1] == 0:
+        return None
+    law = model.hinge_law
+    assert law is not None and model.hinge_kind is not None
+    return HingeResponse(
+        labels=hinge_labels(model),
+        kind=tuple("base" if k == BASE_PLATE else "connector" for k in model.hinge_kind),
+        law=tuple(_LAW_NAMES[int(c)] for c in law),
+        rotation=hist.hinge_rotation, moment=hist.hinge_moment,
+        yield_rotation=np.asarray(model.hinge_yield_rotation, dtype=float))

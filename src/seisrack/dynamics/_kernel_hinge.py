@@ -1,0 +1,237 @@
+"""Newmark trial step with nonlinear hinges and velocity-dependent friction (issue #12).
+
+Same source for the numba build and the pure-Python twin (see ``_kernel_numba.py``). Called by
+``run_kernel`` (``_kernel.py``) in place of its linear ``_trial`` when the structure has
+hinges with a hysteresis law or a slider has velocity-dependent friction; the event core
+(``_events.py``) and the driver are unchanged, so stick/slip events are located inside the step
+exactly as on the linear path. See ``docs/theory/nonlinear_hinges.md``.
+
+Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``):
+
+* hinge ``i`` is a rotational spring between two DOFs (or a DOF and the ground) whose relative
+  rotation is ``θ_i = Q_i q`` (``Q = Bᵀ Φ``). Its elastic stiffness ``k_i`` stays in the modal
+  stiffness ``kd``; the law's moment ``M_i(θ_i)`` enters as the correction ``z_i = M_i − k_i θ_i``
+  (zero while the hinge is elastic), applied as the generalized force ``Qᵀ z``;
+* end-of-step equilibrium of average-acceleration Newmark (β = 1/4, γ = 1/2):
+  ``K̂ Δq = r − Pᵀ λ₁ − Qᵀ z(θ₁)`` with ``K̂ = K + (2/h) C + (4/h²) I``;
+* unknowns ``x = [λ (m sliders), θ (n_h hinges)]``, residuals
+  stuck ``j``: relative velocity ``s_j(x) = 0``; sliding ``j``: ``λ_j + N_j σ_j μ_j(|s_j|) = 0``;
+  hinge ``i``: ``θ_i − Q_i (q₀ + Δq(x)) = 0``; solved by Newton with the laws' consistent
+  tangents (``D = [P; Q]``, ``GG = D K̂⁻¹ Dᵀ``: every block the Jacobian needs);
+* velocity-dependent friction while sliding: ``μ(v) = μ_d + (μ_s − μ_d) e^(−a v)``, equal to
+  μ_s at v = 0 (continuous with the static threshold) and to Coulomb's μ_d as ``a → ∞``.
+"""
+
+# ruff: noqa: N803, N806  (matrix names follow the equations)
+
+import numpy as np
+
+try:  # names injected by the loader when executed after ``_hysteresis.py`` and ``_linalg.py``
+    _hyst_trial  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._events import _JIT
+    from seisrack.dynamics._hysteresis import _hyst_trial
+    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve
+
+STATUS_NEWTON = 4
+_NEWTON_MAX = 60
+_NEWTON_DAMPED = 20  # after this many iterations the steps are halved (breaks branch cycling)
+
+
+@_JIT
+def _mu_slide(mus, mud, rate, v):
+    """Sliding friction coefficient at relative speed ``v`` >= 0 and its derivative."""
+    if rate <= 0.0:
+        return mud, 0.0
+    e = np.exp(-rate * v)
+    return mud + (mus - mud) * e, -rate * (mus - mud) * e
+
+
+@_JIT
+def _mu_now(mus, mud, rate, stuck, s, out):
+    """Friction coefficient a sliding slider carries now (mu_s at zero speed when rate > 0)."""
+    for j in range(mus.shape[0]):
+        mu, _d = _mu_slide(mus[j], mud[j], rate[j], 0.0 if stuck[j] else abs(s[j]))
+        out[j] = mu
+
+
+@_JIT
+def _hinge_state(Q, hk, hlaw, hpar, hst_c, q, hst_t, hM, hz):
+    """Hinge rotations of ``q``: moments ``hM``, corrections ``hz`` and trial states."""
+    for i in range(Q.shape[0]):
+        th = 0.0
+        for k in range(Q.shape[1]):
+            th += Q[i, k] * q[k]
+        Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th, hst_t[i])
+        hM[i] = Mi
+        hz[i] = Mi - hk[i] * th
+
+
+@_JIT
+def _minus_qtz(pe, Q, hz, out):
+    """out = pe − Qᵀ z: the external load with the hinges' correction forces moved over."""
+    for k in range(pe.shape[0]):
+        acc = pe[k]
+        for i in range(Q.shape[0]):
+            acc -= Q[i, k] * hz[i]
+        out[k] = acc
+
+
+@_JIT
+def _nl_trial(
+    h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar, hst_c, hst_t,
+    q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
+    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz,
+):
+    """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
+
+    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ, ``GG`` = D K̂⁻¹ Dᵀ for this ``h``. Writes
+    the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``.
+    Returns STATUS_OK (0) or STATUS_NEWTON when the iteration did not converge.
+    """
+    n = kd.shape[0]
+    m = mass.shape[0]
+    nh = hk.shape[0]
+    nx = m + nh
+    c0 = 4.0 / (h * h)
+    c1 = 4.0 / h
+    c2 = 2.0 / h
+    rhs = np.empty(n)
+    qhat = np.empty(n)
+    _damp_mul(cd, Cq, diag, qd0, rhs)
+    for i in range(n):
+        rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
+    _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)
+    tmp = np.empty(n)
+    for i in range(n):
+        tmp[i] = c2 * qhat[i] - qd0[i]
+    dfree = np.empty(nx)  # [support velocities of the free prediction; free hinge rotations]
+    _mv(D, tmp, dfree)
+    b = np.empty(m)
+    for j in range(m):
+        b[j] = wd0[j] + 0.5 * h * (wdd0[j] - ag1) - dfree[j]
+    for i in range(n):
+        tmp[i] = q0[i] + qhat[i]
+    _mv(D, tmp, dfree)
+    x = np.empty(nx)
+    for j in range(m):
+        x[j] = lam0[j]
+    for i in range(nh):  # linear prediction with the committed corrections
+        acc = dfree[m + i]
+        for j in range(m):
+            acc -= GG[m + i, j] * lam0[j]
+        for k in range(nh):
+            acc -= GG[m + i, m + k] * hz[k]
+        x[m + i] = acc
+    zp = np.empty(nh)
+    R = np.empty((nx, 1))
+    J = np.zeros((nx, nx))
+    ds = np.empty(nx)
+    status = STATUS_NEWTON
+    for it in range(_NEWTON_MAX):
+        for i in range(nh):
+            Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], x[m + i], hst_t[i])
+            hM[i] = Mi
+            hz[i] = Mi - hk[i] * x[m + i]
+            zp[i] = kt - hk[i]
+        for j in range(m):
+            sj = b[j] + 0.5 * h * x[j] / mass[j]
+            for k in range(m):
+                sj += c2 * GG[j, k] * x[k]
+            for k in range(nh):
+                sj += c2 * GG[j, m + k] * hz[k]
+            s1[j] = sj
+            # ds_j / dx
+            for k in range(m):
+                ds[k] = c2 * GG[j, k]
+            ds[j] += 0.5 * h / mass[j]
+            for k in range(nh):
+                ds[m + k] = c2 * GG[j, m + k] * zp[k]
+            if stuck[j]:
+                R[j, 0] = sj
+                for k in range(nx):
+                    J[j, k] = ds[k]
+            else:
+                mu, dmu = _mu_slide(mus[j], mud[j], rate[j], abs(sj))
+                R[j, 0] = x[j] + N1[j] * sig[j] * mu
+                f = N1[j] * sig[j] * dmu * (1.0 if sj >= 0.0 else -1.0)
+                for k in range(nx):
+                    J[j, k] = f * ds[k]
+                J[j, j] += 1.0
+        for i in range(nh):
+            r = x[m + i] - dfree[m + i]
+            for k in range(m):
+                r += GG[m + i, k] * x[k]
+                J[m + i, k] = GG[m + i, k]
+            for k in range(nh):
+                r += GG[m + i, m + k] * hz[k]
+                J[m + i, m + k] = GG[m + i, m + k] * zp[k]
+            J[m + i, m + i] += 1.0
+            R[m + i, 0] = r
+        dx = _solve(J, R)
+        step = 0.5 if it >= _NEWTON_DAMPED else 1.0
+        conv = True
+        for k in range(nx):
+            d = -step * dx[k, 0]
+            scale = abs(x[k]) + (1e-300 if k >= m else mus[k] * N1[k] + 1e-300)
+            if abs(d) > 1e-12 * scale and abs(d) > 1e-16:
+                conv = False
+            x[k] += d
+        if conv and it > 0:
+            status = 0
+            break
+    # final state with the converged unknowns (hinge states for x)
+    for i in range(nh):
+        Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], x[m + i], hst_t[i])
+        hM[i] = Mi
+        hz[i] = Mi - hk[i] * x[m + i]
+    y = np.empty(nx)
+    for j in range(m):
+        y[j] = x[j]
+        lam1[j] = x[j]
+    for i in range(nh):
+        y[m + i] = hz[i]
+    f = np.empty(n)
+    _mv(HDt, y, f)
+    for i in range(n):
+        dq = qhat[i] - f[i]
+        q1[i] = q0[i] + dq
+        qd1[i] = c2 * dq - qd0[i]
+        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
+    vn = np.empty(m)
+    for j in range(m):
+        acc = 0.0
+        for k in range(n):
+            acc += D[j, k] * qd1[k]
+        vn[j] = acc
+    for j in range(m):
+        wdd1[j] = -ag1 + lam1[j] / mass[j]
+        wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
+        w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
+        if stuck[j]:
+            wd1[j] = vn[j]
+        s1[j] = wd1[j] - vn[j]
+    return status
+
+
+@_JIT
+def _hinge_commit(Q, hk, hlaw, hpar, hst_c, hst_t, q0, q1, hM, hz):
+    """Commit the hinges at the accepted end state ``q1`` (the laws are path-independent within
+    a step, so this reproduces the accepted trial); returns the correction forces' work
+    ``∫ z dθ`` over the sub-step (trapezoid, as Newmark's energy identity needs)."""
+    nh = hk.shape[0]
+    work = 0.0
+    for i in range(nh):
+        th0 = 0.0
+        th1 = 0.0
+        for k in range(Q.shape[1]):
+            th0 += Q[i, k] * q0[k]
+            th1 += Q[i, k] * q1[k]
+        z0 = hz[i]
+        Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th1, hst_t[i])
+        hM[i] = Mi
+        hz[i] = Mi - hk[i] * th1
+        work += 0.5 * (z0 + hz[i]) * (th1 - th0)
+        for c in range(hst_c.shape[1]):
+            hst_c[i, c] = hst_t[i, c]
+    return work
