@@ -176,3 +176,132 @@ def test_cli_bad_input_exits_2(args: list[str], tmp_path: Path,
     assert code == 2
     err = capsys.readouterr().err
     assert "error" in err and "Traceback" not in err
+
+
+# --- nonlinear connections ([hysteresis], issue 12) ----------------------------------------------
+
+_HYSTERESIS_TOML = """
+[hysteresis.beam_to_upright]
+law = "pinching"
+envelope_rotation = [0.01, 0.03, 0.06, 0.10]
+envelope_moment = [1600.0, 2400.0, 2800.0, 3000.0]
+negative_envelope_rotation = [0.008, 0.025, 0.05, 0.09]
+negative_envelope_moment = [1280.0, 2000.0, 2300.0, 2450.0]
+reload_rotation_ratio = 0.3
+reload_moment_ratio = 0.2
+unload_moment_ratio = 0.05
+
+[hysteresis.base]
+law = "elastic-plastic"
+yield_moment = 3000.0
+"""
+
+
+def _nonlinear_rack(tmp_path: Path) -> Path:
+    rack = tmp_path / "paper_rack_nl.toml"
+    rack.write_text((EXAMPLES / "paper_rack.toml").read_text() + _HYSTERESIS_TOML)
+    return rack
+
+
+def _script_namespace(text: str) -> dict:
+    """The script's tables (its module body up to the functions; openseespy not needed)."""
+    head = text.split("# --- tags", 1)[0].replace("import openseespy.opensees as ops", "")
+    ns: dict = {}
+    exec(compile(head, "rack_ops.py", "exec"), ns)
+    return ns
+
+
+def test_nonlinear_springs_get_the_laws_materials(tmp_path: Path) -> None:
+    from seisrack.export.opensees_materials import opensees_uniaxial
+    from seisrack.model.frame_model import BASE_PLATE
+
+    spec = load_rack(_nonlinear_rack(tmp_path))
+    model = compile_rack(spec)
+    text = opensees_script(model, pallets="rigid", hysteresis=spec.hysteresis)
+    ns = _script_namespace(text)
+    mats, springs = ns["SPRING_MATERIALS"], ns["SPRINGS"]
+    assert len(mats) == len(springs) == model.hinge_dofs.shape[0] == 7
+    for n, mat in enumerate(mats):
+        law = spec.hysteresis.base if model.hinge_kind[n] == BASE_PLATE \
+            else spec.hysteresis.beam_to_upright
+        args = opensees_uniaxial(law, n + 1)
+        assert (mat[0], *mat[1:]) == (args[0], *args[2:])
+    assert {m[0] for m in mats} == {"Pinching4", "ElasticPP"}
+    head = text.split('"""', 2)[1]
+    assert "Pinching4" in head and "hinge rotation" in head and "K_initial" in head
+
+
+def test_nonlinear_spring_orientation_is_seisrack_hinge_rotation(tmp_path: Path) -> None:
+    """zeroLength deformation u_j − u_i = seisrack's u[a] − u[b] with hinge_dofs = (a, b): node
+    j owns DOF a (beam end / base), node i owns b (upright) or is a fixed ground node."""
+    spec = load_rack(_nonlinear_rack(tmp_path))
+    model = compile_rack(spec)
+    ns = _script_namespace(opensees_script(model, hysteresis=spec.hysteresis))
+    ground = {g[0] for g in ns["GROUND_NODES"]}
+    rz = model.mesh.node_dofs[:, 2]
+    for (i, j, direction, k), (a, b), kh in zip(ns["SPRINGS"], model.hinge_dofs, model.hinge_k,
+                                                strict=True):
+        assert direction == 3 and k == kh
+        assert rz[j - 1] == a
+        assert (i in ground) if b < 0 else (rz[i - 1] == b)
+
+
+def test_linear_rack_text_is_unchanged_by_hysteresis_argument() -> None:
+    spec = load_rack(EXAMPLES / "paper_rack.toml")
+    model = compile_rack(spec)
+    text = opensees_script(model, source="paper_rack.toml")
+    assert text == opensees_script(model, source="paper_rack.toml", hysteresis=spec.hysteresis)
+    assert "SPRING_MATERIALS = []" in text and "Pinching4" not in text
+
+
+def test_nonlinear_export_needs_the_matching_laws(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from seisrack.errors import InputError
+    from seisrack.model.hinge_law import HingeLaw
+
+    spec = load_rack(_nonlinear_rack(tmp_path))
+    model = compile_rack(spec)
+    with pytest.raises(InputError) as err:
+        opensees_script(model)
+    assert err.value.field == "hysteresis"
+    other = replace(spec.hysteresis,
+                    base=HingeLaw("elastic-plastic", 160e3, yield_moment=2000.0))
+    with pytest.raises(InputError) as err:
+        opensees_script(model, hysteresis=other)
+    assert err.value.field == "hysteresis.base" and "2000" in str(err.value)
+    with pytest.raises(InputError) as err:
+        opensees_script(model, hysteresis=replace(spec.hysteresis, base="epp"))
+    assert err.value.field == "hysteresis.base"
+
+
+def test_cli_exports_the_hysteresis(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rack = _nonlinear_rack(tmp_path)
+    assert main(["export", "opensees", str(rack), "--pallets", "rigid"]) == 0
+    text = capsys.readouterr().out
+    spec = load_rack(rack)
+    assert text == opensees_script(compile_rack(spec), pallets="rigid", source=rack.name,
+                                   hysteresis=spec.hysteresis)
+    assert "'Pinching4'" in text and "'ElasticPP'" in text
+
+
+def test_nonlinear_script_runs_in_opensees(tmp_path: Path) -> None:
+    """The exported nonlinear script builds and runs; a strong pulse leaves a residual drift."""
+    pytest.importorskip("openseespy.opensees")
+    spec = load_rack(_nonlinear_rack(tmp_path))
+    script = tmp_path / "rack_ops.py"
+    script.write_text(opensees_script(compile_rack(spec), pallets="rigid",
+                                      hysteresis=spec.hysteresis))
+    code = (
+        f"import json, math, runpy; ns = runpy.run_path({str(script)!r}, run_name='x'); "
+        "ag = [6.0 * math.sin(2 * math.pi * 1.0 * k * 0.005) if k < 200 else 0.0 "
+        "for k in range(1201)]; h = ns['history'](ag, 0.005); "
+        "epp = [n for n, m in enumerate(ns['SPRING_MATERIALS']) if m[0] == 'ElasticPP']; "
+        "print('OUT=' + json.dumps([h['level_displacement'][-1][0], "
+        "max(abs(row[n]) for row in h['spring_force'] for n in epp)]))"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, check=True)
+    drift, m_max = json.loads([x for x in res.stdout.splitlines() if x.startswith("OUT=")][-1][4:])
+    assert 1e-3 < abs(drift) < 0.2
+    assert m_max == pytest.approx(3000.0, rel=1e-9)  # the bases (ElasticPP) reached My

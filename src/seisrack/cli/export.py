@@ -21,7 +21,8 @@ def register(subparsers: Any) -> None:
     o = targets.add_parser(
         "opensees", help="a standalone OpenSeesPy script of the rack",
         description="Write a standalone OpenSeesPy script of the rack: nodes, dispBeamColumn "
-                    "members, connector springs, masses, Rayleigh damping, and pallets as "
+                    "members, connector springs (with their [hysteresis] law: ElasticPP, "
+                    "Steel01 or Pinching4), masses, Rayleigh damping, and pallets as "
                     "friction elements (ElasticPP zeroLength, regularised Coulomb with "
                     "mu_s = mu_d) or rigidly attached. `python rack_ops.py` prints its first "
                     "periods; import it for build(), modal(n) and run(ag, dt). See "
@@ -55,9 +56,11 @@ def run(args: argparse.Namespace) -> int:
         if out.exists() and not args.force:
             raise InputError("--out", args.out, "a file that does not exist yet",
                              hint="Pass --force to overwrite it")
-    model = compile_rack(load_rack(args.rack))
+    spec = load_rack(args.rack)
+    model = compile_rack(spec)
+    # [hysteresis] laws: each connection spring gets the law's OpenSees material
     text = opensees_script(model, pallets=args.pallets, mu=args.mu, k_init=args.k_init,
-                           source=Path(args.rack).name)
+                           source=Path(args.rack).name, hysteresis=spec.hysteresis)
     if out is None:
         sys.stdout.write(text)
         return 0

@@ -2,8 +2,8 @@
 
 Kept apart from the code that writes the data tables so each reads on its own. The text is
 plain Python source using the tables ``NODES``, ``FIX``, ``EQUAL_DOF``, ``SECTIONS``,
-``MEMBERS``, ``GROUND_NODES``, ``SPRINGS``, ``VERTICAL_MASS``, ``PALLETS``, ``LEVEL_NODES``
-and the constants written above it.
+``MEMBERS``, ``GROUND_NODES``, ``SPRINGS``, ``SPRING_MATERIALS``, ``VERTICAL_MASS``,
+``PALLETS``, ``LEVEL_NODES`` and the constants written above it.
 """
 
 FUNCTIONS = '''
@@ -51,8 +51,14 @@ def build(pallets=None):
     for tag, x, y in GROUND_NODES:
         ops.node(tag, x, y)
         ops.fix(tag, 1, 1, 1)
+    # (nonlinear connections: the [hysteresis] law's material; deformation u_j - u_i is
+    # seisrack's hinge rotation)
     for n, (i, j, direction, k) in enumerate(SPRINGS):
-        ops.uniaxialMaterial("Elastic", n + 1, k)
+        if SPRING_MATERIALS:
+            kind, *args = SPRING_MATERIALS[n]
+            ops.uniaxialMaterial(kind, n + 1, *args)
+        else:
+            ops.uniaxialMaterial("Elastic", n + 1, k)
         ops.element("zeroLength", N_MEMBERS + 1 + n, i, j, "-mat", n + 1, "-dir", direction,
                     "-doRayleigh", 1)
 
@@ -71,17 +77,18 @@ def build(pallets=None):
             ops.uniaxialMaterial("ElasticPP", mat, K_INIT, mu * mass * G / K_INIT)
             ops.element("zeroLength", PALLET_ELEMENT[n], beam, node, "-mat", mat, "-dir", 1)
 
-    # damping C = a0 M + a1 K of the structure; the pallets' horizontal masses and friction
-    # elements carry none (as seisrack's sliders)
+    # damping C = a0 M + a1 K_initial of the structure (initial stiffness, as seisrack; for
+    # elastic connections the same as the current one); the pallets' horizontal masses and
+    # friction elements carry none (as seisrack's sliders)
     a0, a1 = RAYLEIGH
     if a0 == 0.0:
-        ops.rayleigh(0.0, a1, 0.0, 0.0)  # pallet elements have no -doRayleigh: undamped
+        ops.rayleigh(0.0, 0.0, a1, 0.0)  # pallet elements have no -doRayleigh: undamped
     else:
         # Nodes first (a0 on the pallets' vertical nodal masses), then the elements with
         # (a0, a1): a node region also sets the factors of every element whose nodes all lie
         # in it, so the element region must come second or the members would lose a1.
         ops.region(1, "-node", *range(1, len(NODES) + 1), "-rayleigh", a0, 0.0, 0.0, 0.0)
-        ops.region(2, "-ele", *range(1, N_STRUCTURE_ELEMENTS + 1), "-rayleigh", a0, a1, 0.0,
+        ops.region(2, "-ele", *range(1, N_STRUCTURE_ELEMENTS + 1), "-rayleigh", a0, 0.0, a1,
                    0.0)
 
 
@@ -116,6 +123,45 @@ def _retry(t_target, dt, tol, max_iter):
     return False
 
 
+def _setup_transient(ag, dt, pallets, tol, max_iter):
+    build(pallets)
+    ops.timeSeries("Path", 1, "-dt", float(dt), "-values", *[float(a) for a in ag])
+    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
+    ops.constraints("Transformation")
+    ops.numberer("RCM")
+    ops.system(SYSTEM)
+    ops.test("NormDispIncr", tol, max_iter)
+    ops.algorithm("Newton")
+    ops.integrator("Newmark", 0.5, 0.25)
+    ops.analysis("Transient")
+
+
+def history(ag, dt, pallets=None, tol=1e-10, max_iter=25):
+    """As run(), but returns the histories, one row per time k dt (k = 0..len(ag)-1):
+
+    {"t": [s], "level_displacement": per step, the mean ux of each level's nodes relative to
+    the ground [m]; "spring_deformation": per step, each spring's deformation u_j - u_i
+    [rad or m] (a connection: seisrack's hinge rotation); "spring_force": its force [N m or N]}.
+    """
+    _setup_transient(ag, dt, pallets, tol, max_iter)
+    springs = range(N_MEMBERS + 1, N_STRUCTURE_ELEMENTS + 1)
+    out = {"t": [], "level_displacement": [], "spring_deformation": [], "spring_force": []}
+
+    def sample():
+        out["t"].append(ops.getTime())
+        out["level_displacement"].append(
+            [sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes) for nodes in LEVEL_NODES])
+        out["spring_deformation"].append([ops.eleResponse(e, "deformation")[0] for e in springs])
+        out["spring_force"].append([ops.eleResponse(e, "basicForce")[0] for e in springs])
+
+    sample()
+    for step in range(1, len(ag)):
+        if ops.analyze(1, dt) != 0 and not _retry(step * dt, dt, tol, max_iter):
+            raise RuntimeError(f"OpenSees did not converge at t = {step * dt:g} s")
+        sample()
+    return out
+
+
 def run(ag, dt, pallets=None, tol=1e-10, max_iter=25):
     """Build the rack afresh and shake it with a horizontal ground acceleration.
 
@@ -127,16 +173,7 @@ def run(ag, dt, pallets=None, tol=1e-10, max_iter=25):
     Returns the peak over time of |mean ux of each level's nodes| relative to the ground [m],
     one per level (bottom to top), as seisrack's beam displacement.
     """
-    build(pallets)
-    ops.timeSeries("Path", 1, "-dt", float(dt), "-values", *[float(a) for a in ag])
-    ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
-    ops.constraints("Transformation")
-    ops.numberer("RCM")
-    ops.system(SYSTEM)
-    ops.test("NormDispIncr", tol, max_iter)
-    ops.algorithm("Newton")
-    ops.integrator("Newmark", 0.5, 0.25)
-    ops.analysis("Transient")
+    _setup_transient(ag, dt, pallets, tol, max_iter)
     peaks = [0.0] * len(LEVEL_NODES)
     for step in range(1, len(ag)):
         if ops.analyze(1, dt) != 0 and not _retry(step * dt, dt, tol, max_iter):

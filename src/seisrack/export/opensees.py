@@ -13,13 +13,22 @@ and the pallet arrays (never from the assembled K, M, C), with the mapping of
   OpenSeesPy 3.7.1 its element mass takes the ground-motion load twice under
   ``UniformExcitation`` (measured in ``benchmarks/opensees_rack.py``);
 - every spring of ``mesh.springs`` is a ``zeroLength`` with an ``Elastic`` material, to a
-  fixed extra node for a spring to the ground, with ``-doRayleigh 1``;
+  fixed extra node for a spring to the ground, with ``-doRayleigh 1``. When the rack's
+  ``[hysteresis]`` gives the connections a nonlinear law (``hysteresis=spec.hysteresis``), each
+  spring's material is instead the law's OpenSees equivalent
+  (:func:`~seisrack.export.opensees_materials.opensees_uniaxial`: ``ElasticPP``, ``Steel01``,
+  ``Pinching4``). Each zeroLength runs from node i to node j so that its deformation
+  u_j − u_i is seisrack's hinge rotation u[a] − u[b] (``model.hinge_dofs = (a, b)``: beam end
+  minus upright for a connector, base rotation for a base plate): an asymmetric law acts with
+  the same sign in both programs;
 - a pallet's vertical mass is nodal mass on its beam node's uy; its horizontal mass sits on its
   own node (uy, rz fixed), joined to the beam node by an ``ElasticPP`` zeroLength (yield force
   mu m g, initial stiffness ``k_init``: a regularised Coulomb law with mu_s = mu_d) or, with
   ``pallets="rigid"``, by ``equalDOF`` in ux;
-- damping ``rayleigh(0, a1)`` or, when a0 != 0, by regions (nodes, then elements), so that the
-  pallets' horizontal masses and friction elements are undamped, as in seisrack.
+- damping C = a0 M + a1 K_initial, ``rayleigh(0, 0, a1, 0)`` (initial stiffness, as
+  seisrack's C; the same as the current one for a linear rack) or, when a0 != 0, by regions
+  (nodes, then elements), so that the pallets' horizontal masses and friction elements are
+  undamped, as in seisrack.
 
 The text depends only on the model and the arguments (no date, no paths other than
 ``source``): the same rack always gives the same script.
@@ -47,7 +56,7 @@ _WIDTH = 99
 
 def opensees_script(
     model: Any, *, pallets: str = "friction", mu: float | None = None, k_init: float = 1e8,
-    record: Any = None, source: str | None = None,
+    record: Any = None, source: str | None = None, hysteresis: Any = None,
 ) -> str:
     """The text of a standalone OpenSeesPy script of ``model`` (a compiled FrameModel).
 
@@ -60,6 +69,11 @@ def opensees_script(
         record: optional :class:`seisrack.motion.Record` written into the script, which then
             runs it when executed as a program.
         source: where the rack came from (e.g. the TOML path), for the header.
+        hysteresis: the rack's moment–rotation laws, ``spec.hysteresis``
+            (:class:`seisrack.model.spec.Hysteresis`) of the spec ``model`` was compiled from.
+            Required when the model has nonlinear connections (``model.nonlinear_hinges``): the
+            springs then get the laws' OpenSees materials. Checked against the model's law
+            codes and parameters.
 
     Returns the script (str), ending with a newline. Run it (``python rack_ops.py`` prints the
     first periods) or import it (``build()``, ``modal(n)``, ``run(ag, dt)``).
@@ -71,13 +85,14 @@ def opensees_script(
     if not (np.isfinite(k_init) and k_init > 0.0):
         raise InputError("k_init", k_init, "a finite stiffness > 0 [N/m]")
     t = _tables(model, mu)
+    materials = _spring_materials(model, hysteresis)
     dense = model.n_dof <= DENSE_MAX_DOF
     mu_d_differs = bool(mu is None and np.any(model.pallet_mu_dynamic != model.pallet_mu_static))
     if mu_d_differs and pallets == "friction":
         log.warning("the OpenSees friction elements use mu_static; the rack's lower dynamic "
                     "coefficients are not represented")
     parts = [
-        _header(model, pallets, mu, k_init, record, source, mu_d_differs),
+        _header(model, pallets, mu, k_init, record, source, mu_d_differs, materials),
         "import math\n\nimport openseespy.opensees as ops\n",
         f"TITLE = {model.title or 'seisrack rack'!r}",
         f"PALLET_MODE = {pallets!r}  # 'friction' or 'rigid': how build() joins the pallets",
@@ -100,6 +115,8 @@ def opensees_script(
                t["ground"]),
         _table("SPRINGS", "(node i, node j, direction, k [N m/rad or N/m]): zeroLength Elastic;"
                " tag = len(MEMBERS) + position + 1", t["springs"]),
+        _table("SPRING_MATERIALS", "per spring, uniaxialMaterial (type, args...) of its "
+               "[hysteresis] law; empty: Elastic k", materials),
         _table("VERTICAL_MASS", "(node, mass [kg]): the pallets' vertical masses",
                t["vertical_mass"]),
         _table("PALLETS", "(own node, beam node, mass [kg], mu, 0-based level), in input order",
@@ -146,7 +163,8 @@ def _tables(model: Any, mu: float | None) -> dict[str, list]:
 
     next_node = n_node + 1
     ground, springs = [], []
-    for (da, db), k in zip(mesh.springs, mesh.spring_k, strict=True):
+    for n, ((da, db), k) in enumerate(zip(mesh.springs, mesh.spring_k, strict=True)):
+        da, db = _oriented(model, n, int(da), int(db))
         a = owner.get(int(da)) if da >= 0 else None
         b = owner.get(int(db)) if db >= 0 else None
         if a is None and b is None:
@@ -185,6 +203,64 @@ def _tables(model: Any, mu: float | None) -> dict[str, list]:
     }
 
 
+def _oriented(model: Any, n: int, da: int, db: int) -> tuple[int, int]:
+    """Spring ``n``'s DOFs ordered (b, a) after its hinge (``model.hinge_dofs[n] = (a, b)``), so
+    that the zeroLength deformation u_j − u_i is the hinge rotation u[a] − u[b]."""
+    hd = getattr(model, "hinge_dofs", None)
+    if hd is None:
+        return da, db
+    a, b = (int(v) for v in hd[n])
+    if {a, b} != {da, db}:
+        raise InputError("model.hinge_dofs", f"hinge {n}: DOFs ({a}, {b})",
+                         f"the DOFs ({da}, {db}) of spring {n} of mesh.springs (one hinge per "
+                         "spring, in the same order)")
+    return b, a
+
+
+def _spring_materials(model: Any, hysteresis: Any) -> list[tuple]:
+    """Per spring, the ``uniaxialMaterial`` (type, args...) of its law; [] when all are elastic
+    (the script then uses ``Elastic`` k, as for a linear rack)."""
+    from seisrack.export.opensees_materials import opensees_uniaxial
+    from seisrack.model.frame_model import BASE_PLATE
+    from seisrack.model.hinge_law import HingeLaw
+
+    nonlinear = bool(getattr(model, "nonlinear_hinges", False))
+    if hysteresis is None:
+        if nonlinear:
+            raise InputError(
+                "hysteresis", None, "the rack's [hysteresis] laws (spec.hysteresis)",
+                hint="This model has nonlinear connections; pass hysteresis=spec.hysteresis "
+                     "of the spec it was compiled from, or the springs would be exported "
+                     "elastic")
+        return []
+    for name in ("beam_to_upright", "base"):
+        law = getattr(hysteresis, name, None)
+        if law is not None and not isinstance(law, HingeLaw):
+            raise InputError(f"hysteresis.{name}", type(law).__name__,
+                             "a seisrack.model.hinge_law.HingeLaw or None")
+    if model.hinge_law is None:
+        raise InputError("model", "a model without hinge arrays",
+                         "a model compiled by seisrack.model.compile_rack")
+    rows = []
+    for n in range(model.hinge_law.shape[0]):
+        is_base = int(model.hinge_kind[n]) == BASE_PLATE
+        law = hysteresis.base if is_base else hysteresis.beam_to_upright
+        if law is None:
+            law = HingeLaw("elastic", float(model.hinge_k[n]))
+        code, par = law.pack()
+        if code != int(model.hinge_law[n]) or not np.array_equal(par, model.hinge_par[n]):
+            raise InputError(
+                f"hysteresis.{'base' if is_base else 'beam_to_upright'}", law.describe(),
+                f"the law the model was compiled with (hinge {n}: law code "
+                f"{int(model.hinge_law[n])}, k = {float(model.hinge_k[n]):.6g} N·m/rad)",
+                hint="Pass spec.hysteresis of the spec given to compile_rack")
+        args = opensees_uniaxial(law, 0)
+        rows.append((args[0], *args[2:]))
+    if not nonlinear:
+        return []
+    return rows
+
+
 def _f(x: float) -> str:
     """Shortest text that reads back as the same float (deterministic, exact)."""
     return repr(float(x))
@@ -196,6 +272,8 @@ def _item(v: Any) -> str:
         if isinstance(v, list):
             return f"[{inner}]"
         return f"({inner},)" if len(v) == 1 else f"({inner})"
+    if isinstance(v, str):
+        return repr(v)
     if isinstance(v, bool | int | np.integer):
         return str(int(v))
     return _f(v)
@@ -237,12 +315,19 @@ def _record(record: Any) -> str:
 
 
 def _header(model: Any, pallets: str, mu: float | None, k_init: float, record: Any,
-            source: str | None, mu_d_differs: bool) -> str:
+            source: str | None, mu_d_differs: bool, materials: Sequence[tuple] = ()) -> str:
     mu_text = (f"mu = {mu:g} for every pallet" if mu is not None
                else "each pallet's mu_static from the rack file")
     mu_note = ("\nNOTE: some pallets have mu_dynamic < mu_static; this model uses mu_static "
                "(it cannot\nhold two coefficients), so it slides later and less than seisrack "
                "there.\n" if mu_d_differs else "")
+    kinds = sorted({m[0] for m in materials})
+    hyst = (f"\n- connections: nonlinear ([hysteresis]): zeroLength with {', '.join(kinds)} "
+            "(see\n  SPRING_MATERIALS); zeroLength deformation u_j - u_i = seisrack's hinge "
+            "rotation." if materials else "")
+    pd_note = ("\nNOTE: the rack has P-Delta ([second_order]) in seisrack; this script uses a "
+               "Linear\ntransformation and no gravity load, so it leaves P-Delta out.\n"
+               if getattr(model, "critical_load_factor", None) is not None else "")
     rec = f"\nGround motion: {record.name} (dt {record.dt:g} s), run by `python` this script.\n" \
         if record is not None else ""
     a0, a1 = model.damping_coefficients
@@ -263,7 +348,7 @@ Modelling choices (as seisrack's compiled model, node for node):
   elasticBeamColumn: in OpenSeesPy 3.7.1 its element mass receives the ground-motion load
   twice under UniformExcitation (measured; see seisrack's benchmarks/opensees_rack.py).
 - semi-rigid joints: the beam end is its own node, equalDOF 1 2 to the upright node, with a
-  zeroLength Elastic rotational spring; base springs go to fixed extra nodes.
+  zeroLength Elastic rotational spring; base springs go to fixed extra nodes.{hyst}
 - pallets (default mode here: {pallets}): vertical mass on the beam node; horizontal mass on
   the pallet's own node (uy, rz fixed), joined to the beam node by
   * "friction": a zeroLength with ElasticPP(K_INIT, mu m g / K_INIT), a regularised Coulomb
@@ -271,10 +356,11 @@ Modelling choices (as seisrack's compiled model, node for node):
     K_INIT = {k_init:g} N/m. Limits: no static/dynamic distinction, no vertical excitation, and the
     elastic stage needs sqrt(K_INIT / m) dt well below 1 (results move with K_INIT and dt);
   * "rigid": equalDOF in ux (no sliding): the pallets move with their beam node.
-- damping: Rayleigh C = a0 M + a1 K with a0 = {a0:.6g}, a1 = {a1:.6g} on the structure only
-  (regions when a0 != 0); the pallets' horizontal masses and friction elements are undamped.
+- damping: Rayleigh C = a0 M + a1 K_initial with a0 = {a0:.6g}, a1 = {a1:.6g} on the
+  structure only (regions when a0 != 0); the pallets' horizontal masses and friction elements
+  are undamped.
 - analysis in run(): UniformExcitation (direction 1, Path time series), Newmark average
   acceleration, Newton + NormDispIncr, Transformation constraints.
-{mu_note}{rec}"""
+{mu_note}{pd_note}{rec}"""
 '''
     return text
