@@ -232,22 +232,24 @@ def pallet_bays(model: FrameModel) -> np.ndarray:
 
 def rack_basis(model: FrameModel, sliders: Sliders, basis: str, av=None,  # noqa: ANN001
                hinges: Hinges | None = None) -> Basis:
-    """The run's basis: every mode up to the engine's ``AUTO_FULL_MAX_DOF`` (more with
-    nonlinear hinges), else the load-dependent Ritz basis of the ground load, the pallets and
-    (with nonlinear hinges) unit moments at the hinges."""
+    """The run's basis: every mode up to the engine's ``AUTO_FULL_MAX_DOF``, else the
+    load-dependent Ritz basis of the ground load, the pallets and (with nonlinear hinges, then
+    ``HINGE_RITZ_BLOCKS`` blocks) unit moments at the hinges."""
     from seisrack.dynamics.basis import full_basis, reduced_basis
-    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF, AUTO_FULL_MAX_DOF_HINGES
+    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF, HINGE_RITZ_BLOCKS, HINGE_RITZ_TOL
 
     if basis not in ("auto", "full", "reduced"):
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    full_max = AUTO_FULL_MAX_DOF if hinges is None else AUTO_FULL_MAX_DOF_HINGES
-    if basis == "full" or (basis == "auto" and model.n_dof <= full_max):
+    if basis == "full" or (basis == "auto" and model.n_dof <= AUTO_FULL_MAX_DOF):
         return full_basis(model.M_sparse, model.K_sparse)
     loads = [model.total_mass_sparse() @ model.r_x]
     if av is not None:
         loads.append(model.M_sparse @ model.r_y)
     if hinges is not None:
         loads.append(hinges.load_vectors(model.n_dof)[:, hinges.law != 0])
+        return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
+                             np.column_stack(loads), blocks=HINGE_RITZ_BLOCKS,
+                             tol=HINGE_RITZ_TOL)
     return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
                          np.column_stack(loads))
 

@@ -141,27 +141,6 @@ def _trial(
 
 
 @_JIT
-def _any_trial(
-    nl, h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar, hst, hst_t,
-    hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N1, stuck, sig, Ainv, cache_ok,
-    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f,
-):
-    """The trial step of either path: linear (``_trial``; ``D`` = P) or nonlinear
-    (``_nl_trial``: hinges and velocity-dependent friction, ``D`` = [P; Q]).
-    Returns (recomputed Ainv, status)."""
-    if nl:
-        hz_t[:] = hz
-        st = _nl_trial(h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar,
-                       hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N1, stuck, sig,
-                       q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t)
-        return False, st
-    rec = _trial(h, kd, cd, Cq, diag, D, HDt, GG, mass, mud, q, qd, qdd, w, wd, wdd, ag1, pe1,
-                 N1, stuck, sig, Ainv, cache_ok, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1,
-                 wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
-    return rec, STATUS_OK
-
-
-@_JIT
 def run_kernel(
     kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hk, hlaw, hpar, hst, dt, ag, pext, N,
     q_init, qd_init, resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
@@ -215,9 +194,15 @@ def run_kernel(
     Wh = np.zeros((4, nh))  # hinge moments, corrections (committed), and trial copies
     hM, hz, hM_t, hz_t = Wh[0], Wh[1], Wh[2], Wh[3]
     hst_t = hst.copy()
+    wn = np.empty((3, n))  # scratch of the nonlinear trial
+    wx = np.empty((9, m + nh))
+    Jn = np.empty((m + nh, m + nh))
     _hinge_state(Q, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
     mu_now = mud.copy()
     pe_eff = np.empty(n)
+    _mv(P, qd, s0)  # relative velocities (a resumed run slides on at mu(|s|))
+    for j in range(m):
+        s0[j] = wd[j] - s0[j]
     _mu_now(mus, mud, rate, stuck, s0, mu_now)
     _minus_qtz(pext[0], Q, hz, pe_eff)
     _consistent(kd, cd, Cq, diag, P, B, mass, mus, mu_now, q, qd, ag[0], pe_eff, N[0],
@@ -225,6 +210,7 @@ def run_kernel(
     n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
                           ev_time, ev_slider, ev_kind)
     status = STATUS_OK
+    st_tr = STATUS_OK
     # trial end state and its copy at the bracket's hi end
     T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(3, n, 5, m)
     q1, qd1, qdd1 = T1[0], T1[1], T1[2]
@@ -260,13 +246,19 @@ def run_kernel(
             else:
                 HPt = _hmat_pt(kd, cd, Cq, diag, hrem, D)
                 G = _mm_pt(D, np.ascontiguousarray(HPt.T))
-            use_cache = cache_ok and full
-            recomputed, st_tr = _any_trial(
-                nl, hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw, hpar,
-                hst, hst_t, hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
-                stuck, sig, Ainv, use_cache, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1,
-                wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
-            cache_ok = (cache_ok or recomputed) and full
+            if nl:  # hinges / velocity-dependent friction (_kernel_hinge.py)
+                hz_t[:] = hz
+                st_tr = _nl_trial(
+                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw, hpar,
+                    hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1], stuck, sig,
+                    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Jn)
+            else:
+                use_cache = cache_ok and full
+                recomputed = _trial(
+                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd, ag1,
+                    pe1, N[step + 1], stuck, sig, Ainv, use_cache, q1, qd1, qdd1, w1, wd1, wdd1,
+                    lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
+                cache_ok = (cache_ok or recomputed) and full
             if st_tr != STATUS_OK:
                 status = st_tr
                 break
@@ -287,11 +279,17 @@ def run_kernel(
                     hsub = th * hrem
                     HPt = _hmat_pt(kd, cd, Cq, diag, hsub, D)
                     G = _mm_pt(D, np.ascontiguousarray(HPt.T))
-                    _rec, st_tr = _any_trial(
-                        nl, hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw,
-                        hpar, hst, hst_t, hz, hz_t, hM_t, q, qd, qdd, w, wd, wdd, lam, ag_e,
-                        tmpn, N_e, stuck, sig, Ainv, False, q1, qd1, qdd1, w1, wd1, wdd1, lam1,
-                        s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
+                    if nl:
+                        hz_t[:] = hz
+                        st_tr = _nl_trial(
+                            hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw,
+                            hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e,
+                            stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t,
+                            wn, wx, Jn)
+                    else:
+                        _trial(hsub, kd, cd, Cq, diag, D, HPt, G, mass, mud, q, qd, qdd, w, wd,
+                               wdd, ag_e, tmpn, N_e, stuck, sig, Ainv, False, q1, qd1, qdd1,
+                               w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
                     cache_ok = False
                     if st_tr != STATUS_OK:
                         status = st_tr
@@ -330,7 +328,7 @@ def run_kernel(
                 E_in += dq_in
                 E_damp += dd
             if nh > 0:
-                E_z += _hinge_commit(Q, hk, hlaw, hpar, hst, hst_t, q, q1, hM, hz)
+                E_z += _hinge_commit(Q, hk, hlaw, hpar, hst, hst_t, q1, hM, hz, not any_ev)
             T0[:] = T1
             S0[:] = S1
             if tau_end >= 1.0:

@@ -30,12 +30,46 @@ try:  # names injected by the loader when executed after ``_hysteresis.py`` and 
     _hyst_trial  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT
-    from seisrack.dynamics._hysteresis import _hyst_trial
-    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve
+    from seisrack.dynamics._hysteresis import HYST_S_M, HYST_S_THETA, _hyst_trial
+    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv
 
 STATUS_NEWTON = 4
 _NEWTON_MAX = 60
 _NEWTON_DAMPED = 20  # after this many iterations the steps are halved (breaks branch cycling)
+
+
+@_JIT
+def _solve_inplace(A, x):
+    """Solve A y = x by Gaussian elimination with partial pivoting, overwriting A and x with
+    the factors and y (no allocation: it runs in every Newton iteration)."""
+    k = A.shape[0]
+    for c in range(k):
+        piv = c
+        big = abs(A[c, c])
+        for i in range(c + 1, k):
+            if abs(A[i, c]) > big:
+                big = abs(A[i, c])
+                piv = i
+        if piv != c:
+            for j in range(k):
+                t = A[c, j]
+                A[c, j] = A[piv, j]
+                A[piv, j] = t
+            t = x[c]
+            x[c] = x[piv]
+            x[piv] = t
+        d = A[c, c]
+        for i in range(c + 1, k):
+            f = A[i, c] / d
+            if f != 0.0:
+                for j in range(c + 1, k):
+                    A[i, j] -= f * A[c, j]
+                x[i] -= f * x[c]
+    for c in range(k - 1, -1, -1):
+        acc = x[c]
+        for j in range(c + 1, k):
+            acc -= A[c, j] * x[j]
+        x[c] = acc / A[c, c]
 
 
 @_JIT
@@ -81,12 +115,18 @@ def _minus_qtz(pe, Q, hz, out):
 def _nl_trial(
     h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar, hst_c, hst_t,
     q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
-    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz,
+    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, J,
 ):
     """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
 
     ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ, ``GG`` = D K̂⁻¹ Dᵀ for this ``h``. Writes
     the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``.
+    ``wn`` (3, n), ``wx`` (9, m + n_h) and ``J`` (m + n_h, m + n_h) are scratch.
+
+    Every hysteresis law is piecewise linear, so once an iterate lands on the same branch (same
+    tangent and intercept of every hinge) as the linearisation it came from, it solves the
+    step exactly (up to round-off): the iteration stops there. Otherwise (velocity-dependent
+    friction while sliding) it stops when the Newton step is below 1e-12 of the unknowns.
     Returns STATUS_OK (0) or STATUS_NEWTON when the iteration did not converge.
     """
     n = kd.shape[0]
@@ -96,24 +136,22 @@ def _nl_trial(
     c0 = 4.0 / (h * h)
     c1 = 4.0 / h
     c2 = 2.0 / h
-    rhs = np.empty(n)
-    qhat = np.empty(n)
+    rhs, qhat, tmp = wn[0], wn[1], wn[2]
+    dfree, b, x, zp, R, ds, y = wx[0], wx[1], wx[2], wx[3], wx[4], wx[5], wx[6]
+    kt_lin, c_lin = wx[7], wx[8]  # each hinge's branch (tangent, intercept) of the last solve
     _damp_mul(cd, Cq, diag, qd0, rhs)
     for i in range(n):
         rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
     _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)
-    tmp = np.empty(n)
     for i in range(n):
         tmp[i] = c2 * qhat[i] - qd0[i]
-    dfree = np.empty(nx)  # [support velocities of the free prediction; free hinge rotations]
+    # dfree: support velocities of the free prediction (then: free hinge rotations)
     _mv(D, tmp, dfree)
-    b = np.empty(m)
     for j in range(m):
         b[j] = wd0[j] + 0.5 * h * (wdd0[j] - ag1) - dfree[j]
     for i in range(n):
         tmp[i] = q0[i] + qhat[i]
     _mv(D, tmp, dfree)
-    x = np.empty(nx)
     for j in range(m):
         x[j] = lam0[j]
     for i in range(nh):  # linear prediction with the committed corrections
@@ -123,17 +161,29 @@ def _nl_trial(
         for k in range(nh):
             acc -= GG[m + i, m + k] * hz[k]
         x[m + i] = acc
-    zp = np.empty(nh)
-    R = np.empty((nx, 1))
-    J = np.zeros((nx, nx))
-    ds = np.empty(nx)
+    smooth = False  # some sliding slider has velocity-dependent friction
+    for j in range(m):
+        if not stuck[j] and rate[j] > 0.0:
+            smooth = True
     status = STATUS_NEWTON
+    done = False
     for it in range(_NEWTON_MAX):
+        same = it > 0 and not smooth
         for i in range(nh):
-            Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], x[m + i], hst_t[i])
+            th = x[m + i]
+            Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th, hst_t[i])
             hM[i] = Mi
-            hz[i] = Mi - hk[i] * x[m + i]
+            hz[i] = Mi - hk[i] * th
             zp[i] = kt - hk[i]
+            c = Mi - kt * th
+            if same and (kt != kt_lin[i]
+                         or abs(c - c_lin[i]) > 1e-12 * (abs(Mi) + abs(kt * th) + 1e-300)):
+                same = False
+            kt_lin[i] = kt
+            c_lin[i] = c
+        if done or same:
+            status = 0
+            break
         for j in range(m):
             sj = b[j] + 0.5 * h * x[j] / mass[j]
             for k in range(m):
@@ -148,12 +198,12 @@ def _nl_trial(
             for k in range(nh):
                 ds[m + k] = c2 * GG[j, m + k] * zp[k]
             if stuck[j]:
-                R[j, 0] = sj
+                R[j] = sj
                 for k in range(nx):
                     J[j, k] = ds[k]
             else:
                 mu, dmu = _mu_slide(mus[j], mud[j], rate[j], abs(sj))
-                R[j, 0] = x[j] + N1[j] * sig[j] * mu
+                R[j] = x[j] + N1[j] * sig[j] * mu
                 f = N1[j] * sig[j] * dmu * (1.0 if sj >= 0.0 else -1.0)
                 for k in range(nx):
                     J[j, k] = f * ds[k]
@@ -167,68 +217,65 @@ def _nl_trial(
                 r += GG[m + i, m + k] * hz[k]
                 J[m + i, m + k] = GG[m + i, m + k] * zp[k]
             J[m + i, m + i] += 1.0
-            R[m + i, 0] = r
-        dx = _solve(J, R)
+            R[m + i] = r
+        _solve_inplace(J, R)  # R becomes the Newton step (negated)
         step = 0.5 if it >= _NEWTON_DAMPED else 1.0
         conv = True
         for k in range(nx):
-            d = -step * dx[k, 0]
+            d = -step * R[k]
             scale = abs(x[k]) + (1e-300 if k >= m else mus[k] * N1[k] + 1e-300)
             if abs(d) > 1e-12 * scale and abs(d) > 1e-16:
                 conv = False
             x[k] += d
-        if conv and it > 0:
-            status = 0
-            break
-    # final state with the converged unknowns (hinge states for x)
-    for i in range(nh):
-        Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], x[m + i], hst_t[i])
-        hM[i] = Mi
-        hz[i] = Mi - hk[i] * x[m + i]
-    y = np.empty(nx)
+        done = conv and it > 0  # evaluate the hinges at the final x, then stop
+    # x is final and the hinges (hM, hz, hst_t) were evaluated at it
     for j in range(m):
         y[j] = x[j]
         lam1[j] = x[j]
     for i in range(nh):
         y[m + i] = hz[i]
-    f = np.empty(n)
+    f = tmp
     _mv(HDt, y, f)
     for i in range(n):
         dq = qhat[i] - f[i]
         q1[i] = q0[i] + dq
         qd1[i] = c2 * dq - qd0[i]
         qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
-    vn = np.empty(m)
-    for j in range(m):
-        acc = 0.0
-        for k in range(n):
-            acc += D[j, k] * qd1[k]
-        vn[j] = acc
     for j in range(m):
         wdd1[j] = -ag1 + lam1[j] / mass[j]
         wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
         w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
+        vj = 0.0
+        for k in range(n):
+            vj += D[j, k] * qd1[k]
         if stuck[j]:
-            wd1[j] = vn[j]
-        s1[j] = wd1[j] - vn[j]
+            wd1[j] = vj
+        s1[j] = wd1[j] - vj
     return status
 
 
 @_JIT
-def _hinge_commit(Q, hk, hlaw, hpar, hst_c, hst_t, q0, q1, hM, hz):
-    """Commit the hinges at the accepted end state ``q1`` (the laws are path-independent within
-    a step, so this reproduces the accepted trial); returns the correction forces' work
-    ``∫ z dθ`` over the sub-step (trapezoid, as Newmark's energy identity needs)."""
+def _hinge_commit(Q, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
+    """Commit the hinges at the accepted end state ``q1``; returns the correction forces' work
+    ``∫ z dθ`` over the sub-step (trapezoid, as Newmark's energy identity needs).
+
+    ``fresh``: the accepted state is the last trial's, whose hinge states ``hst_t`` are
+    current; otherwise (an event was located, the accepted state may be an earlier trial) they
+    are recomputed at ``q1`` (the laws depend only on the committed state and θ).
+    """
     nh = hk.shape[0]
     work = 0.0
     for i in range(nh):
-        th0 = 0.0
-        th1 = 0.0
-        for k in range(Q.shape[1]):
-            th0 += Q[i, k] * q0[k]
-            th1 += Q[i, k] * q1[k]
+        th0 = hst_c[i, HYST_S_THETA]
         z0 = hz[i]
-        Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th1, hst_t[i])
+        if fresh:
+            th1 = hst_t[i, HYST_S_THETA]
+            Mi = hst_t[i, HYST_S_M]
+        else:
+            th1 = 0.0
+            for k in range(Q.shape[1]):
+                th1 += Q[i, k] * q1[k]
+            Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th1, hst_t[i])
         hM[i] = Mi
         hz[i] = Mi - hk[i] * th1
         work += 0.5 * (z0 + hz[i]) * (th1 - th0)
