@@ -60,7 +60,8 @@ def rack_hinges(model: FrameModel) -> Hinges | None:
     """The model's connection springs as engine hinges, or None when all are elastic."""
     if not model.nonlinear_hinges:
         return None
-    return Hinges(model.hinge_dofs, model.hinge_k, model.hinge_law, model.hinge_par)
+    return Hinges(model.hinge_dofs, model.hinge_k, model.hinge_law, model.hinge_par,
+                  model.hinge_rotation_gravity)
 
 
 def hinge_labels(model: FrameModel) -> tuple[str, ...]:

@@ -283,6 +283,24 @@ class RackResponse:
             "n_events": len(self.events),
             "n_slip_events": n_slip,
             "energy_balance_error": self.history.energy_error() if self.energy else None,
+            "energy_J": {k: float(v[-1]) for k, v in self.energy.items()},
+            **({} if self.hinges is None else {"hinges": self.hinge_summary()}),
+        }
+
+    def hinge_summary(self) -> dict[str, Any]:
+        """Nonlinear connections: how many yielded, the largest ductility demand, the
+        hysteretic energy and every hinge's peaks (see :class:`HingeResponse`)."""
+        rows = self.hinges.peaks()
+        duct = [(r["ductility"], r["hinge"]) for r in rows if r["ductility"] is not None]
+        top = max(duct) if duct else (None, None)
+        hyst = self.energy.get("hysteresis")
+        return {
+            "count": len(rows),
+            "yielded": sum(r["yielded"] for r in rows),
+            "peak_ductility": top[0],
+            "peak_ductility_hinge": top[1],
+            "hysteretic_energy_J": None if hyst is None else float(hyst[-1]),
+            "hinges": rows,
         }
 
 

@@ -142,7 +142,7 @@ def _trial(
 
 @_JIT
 def run_kernel(
-    kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hk, hlaw, hpar, hst, dt, ag, pext, N,
+    kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hth0, hk, hlaw, hpar, hst, dt, ag, pext, N,
     q_init, qd_init, resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
     track_energy, max_events, max_substeps,
     out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy, out_hm,
@@ -160,7 +160,8 @@ def run_kernel(
     ag: (n_t,) ground acceleration at grid points; pext: (n_t, n) modal external load
     (``Φ^T (F - M r a_g)``); N: (n_t, m) normal force of each slider.
     rate: (m,) velocity-dependence of friction [s/m] (0: Coulomb). Hinges (``_kernel_hinge``):
-    Q (n_h, n) rotations of the basis coordinates, hk (n_h,) elastic stiffness, hlaw, hpar,
+    Q (n_h, n) rotations of the basis coordinates, hth0 (n_h,) rotations of the state the run
+    starts from (q = 0), hk (n_h,) elastic stiffness, hlaw, hpar,
     hst (n_h, HYST_NSTATE) law, parameters and committed state; out_hm (n_t, n_h) moments.
     out_energy columns: input, kinetic, strain (with the hinges' correction work, so that the
     column is the structure's whole internal work), damping, friction dissipation (cumulative).
@@ -197,7 +198,7 @@ def run_kernel(
     wn = np.empty((3, n))  # scratch of the nonlinear trial
     wx = np.empty((9, m + nh))
     Jn = np.empty((m + nh, m + nh))
-    _hinge_state(Q, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
+    _hinge_state(Q, hth0, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
     mu_now = mud.copy()
     pe_eff = np.empty(n)
     _mv(P, qd, s0)  # relative velocities (a resumed run slides on at mu(|s|))
@@ -249,9 +250,9 @@ def run_kernel(
             if nl:  # hinges / velocity-dependent friction (_kernel_hinge.py)
                 hz_t[:] = hz
                 st_tr = _nl_trial(
-                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw, hpar,
-                    hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1], stuck, sig,
-                    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Jn)
+                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hth0, hk,
+                    hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
+                    stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Jn)
             else:
                 use_cache = cache_ok and full
                 recomputed = _trial(
@@ -282,8 +283,8 @@ def run_kernel(
                     if nl:
                         hz_t[:] = hz
                         st_tr = _nl_trial(
-                            hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hk, hlaw,
-                            hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e,
+                            hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hth0, hk,
+                            hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e,
                             stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t,
                             wn, wx, Jn)
                     else:
@@ -328,7 +329,8 @@ def run_kernel(
                 E_in += dq_in
                 E_damp += dd
             if nh > 0:
-                E_z += _hinge_commit(Q, hk, hlaw, hpar, hst, hst_t, q1, hM, hz, not any_ev)
+                E_z += _hinge_commit(Q, hth0, hk, hlaw, hpar, hst, hst_t, q1, hM, hz,
+                                     not any_ev)
             T0[:] = T1
             S0[:] = S1
             if tau_end >= 1.0:

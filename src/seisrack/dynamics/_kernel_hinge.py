@@ -9,14 +9,16 @@ exactly as on the linear path. See ``docs/theory/nonlinear_hinges.md``.
 Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``):
 
 * hinge ``i`` is a rotational spring between two DOFs (or a DOF and the ground) whose relative
-  rotation is ``θ_i = Q_i q`` (``Q = Bᵀ Φ``). Its elastic stiffness ``k_i`` stays in the modal
-  stiffness ``kd``; the law's moment ``M_i(θ_i)`` enters as the correction ``z_i = M_i − k_i θ_i``
-  (zero while the hinge is elastic), applied as the generalized force ``Qᵀ z``;
+  rotation is ``θ_i = θ0_i + Q_i q`` (``Q = Bᵀ Φ``; ``θ0`` its rotation in the static state
+  the motion starts from, e.g. under gravity, since ``q`` is measured from that state). Its
+  elastic stiffness ``k_i`` stays in the modal stiffness ``kd``; the law's moment ``M_i(θ_i)``
+  enters as the correction ``z_i = M_i − k_i θ_i`` (zero while the hinge is elastic), applied
+  as the generalized force ``Qᵀ z``;
 * end-of-step equilibrium of average-acceleration Newmark (β = 1/4, γ = 1/2):
   ``K̂ Δq = r − Pᵀ λ₁ − Qᵀ z(θ₁)`` with ``K̂ = K + (2/h) C + (4/h²) I``;
 * unknowns ``x = [λ (m sliders), θ (n_h hinges)]``, residuals
   stuck ``j``: relative velocity ``s_j(x) = 0``; sliding ``j``: ``λ_j + N_j σ_j μ_j(|s_j|) = 0``;
-  hinge ``i``: ``θ_i − Q_i (q₀ + Δq(x)) = 0``; solved by Newton with the laws' consistent
+  hinge ``i``: ``θ_i − θ0_i − Q_i (q₀ + Δq(x)) = 0``; solved by Newton with the laws' consistent
   tangents (``D = [P; Q]``, ``GG = D K̂⁻¹ Dᵀ``: every block the Jacobian needs);
 * velocity-dependent friction while sliding: ``μ(v) = μ_d + (μ_s − μ_d) e^(−a v)``, equal to
   μ_s at v = 0 (continuous with the static threshold) and to Coulomb's μ_d as ``a → ∞``.
@@ -90,10 +92,10 @@ def _mu_now(mus, mud, rate, stuck, s, out):
 
 
 @_JIT
-def _hinge_state(Q, hk, hlaw, hpar, hst_c, q, hst_t, hM, hz):
+def _hinge_state(Q, hth0, hk, hlaw, hpar, hst_c, q, hst_t, hM, hz):
     """Hinge rotations of ``q``: moments ``hM``, corrections ``hz`` and trial states."""
     for i in range(Q.shape[0]):
-        th = 0.0
+        th = hth0[i]
         for k in range(Q.shape[1]):
             th += Q[i, k] * q[k]
         Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th, hst_t[i])
@@ -113,13 +115,13 @@ def _minus_qtz(pe, Q, hz, out):
 
 @_JIT
 def _nl_trial(
-    h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hk, hlaw, hpar, hst_c, hst_t,
+    h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
     q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, J,
 ):
     """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
 
-    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ, ``GG`` = D K̂⁻¹ Dᵀ for this ``h``. Writes
+    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ, ``GG`` = D K̂⁻¹ Dᵀ for this ``h``; Writes
     the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``.
     ``wn`` (3, n), ``wx`` (9, m + n_h) and ``J`` (m + n_h, m + n_h) are scratch.
 
@@ -152,6 +154,8 @@ def _nl_trial(
     for i in range(n):
         tmp[i] = q0[i] + qhat[i]
     _mv(D, tmp, dfree)
+    for i in range(nh):
+        dfree[m + i] += hth0[i]
     for j in range(m):
         x[j] = lam0[j]
     for i in range(nh):  # linear prediction with the committed corrections
@@ -255,7 +259,7 @@ def _nl_trial(
 
 
 @_JIT
-def _hinge_commit(Q, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
+def _hinge_commit(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
     """Commit the hinges at the accepted end state ``q1``; returns the correction forces' work
     ``∫ z dθ`` over the sub-step (trapezoid, as Newmark's energy identity needs).
 
@@ -272,7 +276,7 @@ def _hinge_commit(Q, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
             th1 = hst_t[i, HYST_S_THETA]
             Mi = hst_t[i, HYST_S_M]
         else:
-            th1 = 0.0
+            th1 = hth0[i]
             for k in range(Q.shape[1]):
                 th1 += Q[i, k] * q1[k]
             Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th1, hst_t[i])

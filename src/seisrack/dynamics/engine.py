@@ -249,7 +249,8 @@ def simulate(
     nh = hinges.count if hinges.nonlinear else 0
     Q = hinges.operator(phi)[:nh]
     hst = hinges.initial_state()[:nh]
-    h_k, h_law, h_par = hinges.k[:nh], hinges.law[:nh], hinges.par[:nh]
+    h_k, h_law, h_par, h_th0 = hinges.k[:nh], hinges.law[:nh], hinges.par[:nh], \
+        hinges.theta0[:nh]
     rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
     buf = _Buffers(chunk + 1, nb, m, nh)
     keep = _Kept(n_keep, nb, m, track_energy, nh)
@@ -293,7 +294,7 @@ def simulate(
                 n_cfg += int(nc)
             else:
                 st, ne, ns = kern.run_kernel(
-                    w2c, cd, Cq, diag, P, mass, mus, mud, rate, Q, h_k, h_law, h_par, hst,
+                    w2c, cd, Cq, diag, P, mass, mus, mud, rate, Q, h_th0, h_k, h_law, h_par, hst,
                     float(dt), ag[rows], pext, N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
@@ -332,7 +333,8 @@ def simulate(
         energy = {nm: ken[:, c].copy() for c, nm in enumerate(names)}
         if nh:
             energy["strain"], energy["hysteresis"] = energy_split(
-                energy["strain"], kq, w2, kq @ Q.T, khm, h_k)
+                energy["strain"], kq, w2, kq @ Q.T + h_th0, khm, h_k, h_th0,
+                hinges.initial_moment()[:nh])
     return TimeHistory(
         t=kidx * dt,
         q=kq,
@@ -357,6 +359,7 @@ def simulate(
         sample_index=kidx,
         hinge_moment=khm,
         hinge_operator=Q,
+        hinge_rotation0=h_th0,
     )
 
 

@@ -20,12 +20,16 @@ from seisrack.errors import InputError
 class Hinges:
     """dofs: (n_h, 2) int, the two DOFs whose rotation difference ``u[a] − u[b]`` is the hinge
     rotation (``b = -1``: the ground); k: (n_h,) elastic stiffness already in K [N·m/rad];
-    law: (n_h,) int law code (``HYST_*``); par: (n_h, HYST_NPAR) law parameters."""
+    law: (n_h,) int law code (``HYST_*``); par: (n_h, HYST_NPAR) law parameters;
+    theta0: (n_h,) [rad] rotation in the static state the motion starts from (the engine's
+    displacements are measured from it: e.g. the rack under gravity), default 0. The laws
+    start there as if loaded monotonically from zero."""
 
     dofs: np.ndarray
     k: np.ndarray
     law: np.ndarray
     par: np.ndarray
+    theta0: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         dofs = np.asarray(self.dofs, dtype=np.int64).reshape(-1, 2)
@@ -43,7 +47,11 @@ class Hinges:
         if np.any((law < hy.HYST_ELASTIC) | (law > hy.HYST_PINCHING)):
             raise InputError("hinges.law", law.tolist(),
                              f"law codes {hy.HYST_ELASTIC}..{hy.HYST_PINCHING}")
-        for name, v in (("dofs", dofs), ("k", k), ("law", law), ("par", par)):
+        th0 = np.zeros(n_h) if self.theta0 is None else \
+            np.asarray(self.theta0, dtype=float).reshape(-1)
+        if th0.shape != (n_h,) or not np.all(np.isfinite(th0)):
+            raise InputError("hinges.theta0", th0.tolist(), f"{n_h} finite rotations [rad]")
+        for name, v in (("dofs", dofs), ("k", k), ("law", law), ("par", par), ("theta0", th0)):
             object.__setattr__(self, name, np.ascontiguousarray(v))
 
     @property
@@ -72,11 +80,20 @@ class Hinges:
         return out
 
     def initial_state(self) -> np.ndarray:
-        """(n_h, HYST_NSTATE) virgin states (θ = 0, M = 0)."""
+        """(n_h, HYST_NSTATE) committed states at ``theta0`` (one monotonic step from the
+        virgin state θ = 0, M = 0)."""
         st = np.zeros((self.count, hy.HYST_NSTATE))
+        tmp = np.zeros(hy.HYST_NSTATE)
         for i in range(self.count):
             hy._hyst_init(int(self.law[i]), self.par[i], st[i])
+            if self.theta0[i] != 0.0:
+                hy._hyst_trial(int(self.law[i]), self.par[i], st[i], float(self.theta0[i]), tmp)
+                st[i] = tmp
         return st
+
+    def initial_moment(self) -> np.ndarray:
+        """(n_h,) [N·m] moments at ``theta0``."""
+        return self.initial_state()[:, hy.HYST_S_M].copy()
 
     def check(self, n: int) -> None:
         """DOFs within the structure's ``n`` DOFs."""
@@ -93,15 +110,17 @@ def no_hinges() -> Hinges:
 
 
 def energy_split(strain_total: np.ndarray, q: np.ndarray, kd: np.ndarray, theta: np.ndarray,
-                 moment: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                 moment: np.ndarray, k: np.ndarray, theta0: np.ndarray, moment0: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
     """(strain, hysteresis) [J] from the kernel's internal-work column.
 
-    ``strain_total`` = ½ qᵀ diag(kd) q + ∫ z dθ (every hinge's elastic spring is in ``kd``).
-    A hinge's work ∫ M dθ = ½ k θ² + ∫ z dθ splits into the elastic energy it would give back
-    on unloading at its elastic stiffness, M²/(2k), and the hysteretic (dissipated) rest.
+    ``strain_total`` = ½ qᵀ diag(kd) q + ∫ z dθ: the structure's work measured from the
+    starting state. Every hinge's elastic spring is in ``kd``, so a hinge's work is
+    ∫ M dθ = ½ k (θ² − θ0²) + ∫ z dθ. Of it, the hinge keeps M²/(2k) − M0²/(2k) as elastic
+    energy it would give back on unloading at its elastic stiffness; the rest is hysteretic
+    (dissipated). q: (n_t, r); kd: (r,); theta, moment: (n_t, n_h); theta0, moment0: (n_h,).
     """
     elastic_q = 0.5 * np.einsum("ti,i,ti->t", q, kd, q)
-    spring = 0.5 * (theta**2) @ k
-    recoverable = (moment**2) @ (0.5 / k)
-    hysteresis = strain_total - elastic_q + spring - recoverable
-    return elastic_q - spring + recoverable, hysteresis
+    work_z = strain_total - elastic_q
+    hysteresis = work_z + 0.5 * (theta**2 - theta0**2) @ k - (moment**2 - moment0**2) @ (0.5 / k)
+    return strain_total - hysteresis, hysteresis

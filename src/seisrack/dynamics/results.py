@@ -61,13 +61,16 @@ class TimeHistory:
     sample_index: np.ndarray | None = None
     hinge_moment: np.ndarray | None = None
     hinge_operator: np.ndarray | None = None
+    hinge_rotation0: np.ndarray | None = None
 
     @property
     def hinge_rotation(self) -> np.ndarray | None:
-        """(n_t, n_h) [rad] rotation of each nonlinear hinge (None without them)."""
+        """(n_t, n_h) [rad] rotation of each nonlinear hinge, from its zero-moment state (the
+        state the run starts from has ``hinge_rotation0``); None without hinges."""
         if self.hinge_operator is None:
             return None
-        return self.q @ self.hinge_operator.T
+        th0 = 0.0 if self.hinge_rotation0 is None else self.hinge_rotation0
+        return self.q @ self.hinge_operator.T + th0
 
     @cached_property
     def u(self) -> np.ndarray:

@@ -123,8 +123,40 @@ def _retry(t_target, dt, tol, max_iter):
     return False
 
 
+def gravity(tol=1e-10, max_iter=25):
+    """Load the built rack with its own and its pallets' weight (static, then held constant):
+    the members' weight as a uniform load (-beamUniform, the consistent load of seisrack's
+    -g M r_y), each pallet's weight on its beam node. The earthquake starts from this state,
+    as in seisrack, where a connection carries its gravity moment before the shaking.
+    Returns the mean ux of each level's nodes under gravity [m]."""
+    ops.timeSeries("Constant", 100)
+    ops.pattern("Plain", 100, 100)
+    for tag, (i, j, sec) in enumerate(MEMBERS, start=1):
+        (xi, yi), (xj, yj) = NODES[i - 1], NODES[j - 1]
+        length = math.hypot(xj - xi, yj - yi)
+        w = SECTIONS[sec - 1][3] * G  # weight per length [N/m]
+        c, s = (xj - xi) / length, (yj - yi) / length
+        ops.eleLoad("-ele", tag, "-type", "-beamUniform", -w * c, -w * s)  # local y, local x
+    for node, mass in VERTICAL_MASS:
+        ops.load(node, 0.0, -mass * G, 0.0)
+    ops.constraints("Transformation")
+    ops.numberer("RCM")
+    ops.system(SYSTEM)
+    ops.test("NormDispIncr", tol, max_iter)
+    ops.algorithm("Newton")
+    ops.integrator("LoadControl", 1.0)
+    ops.analysis("Static")
+    if ops.analyze(1) != 0:
+        raise RuntimeError("OpenSees: the static gravity analysis did not converge")
+    ops.loadConst("-time", 0.0)
+    ops.wipeAnalysis()
+    return [sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes) for nodes in LEVEL_NODES]
+
+
 def _setup_transient(ag, dt, pallets, tol, max_iter):
+    """Build, apply gravity, set up the transient; returns the gravity level displacements."""
     build(pallets)
+    u_g = gravity(tol, max_iter)
     ops.timeSeries("Path", 1, "-dt", float(dt), "-values", *[float(a) for a in ag])
     ops.pattern("UniformExcitation", 1, 1, "-accel", 1)
     ops.constraints("Transformation")
@@ -134,23 +166,27 @@ def _setup_transient(ag, dt, pallets, tol, max_iter):
     ops.algorithm("Newton")
     ops.integrator("Newmark", 0.5, 0.25)
     ops.analysis("Transient")
+    return u_g
 
 
 def history(ag, dt, pallets=None, tol=1e-10, max_iter=25):
     """As run(), but returns the histories, one row per time k dt (k = 0..len(ag)-1):
 
     {"t": [s], "level_displacement": per step, the mean ux of each level's nodes relative to
-    the ground [m]; "spring_deformation": per step, each spring's deformation u_j - u_i
-    [rad or m] (a connection: seisrack's hinge rotation); "spring_force": its force [N m or N]}.
+    the ground and to the gravity state (as seisrack's beam displacement) [m];
+    "spring_deformation": per step, each spring's deformation u_j - u_i [rad or m] (a
+    connection: seisrack's hinge rotation, gravity included); "spring_force": its force
+    [N m or N]}.
     """
-    _setup_transient(ag, dt, pallets, tol, max_iter)
+    u_g = _setup_transient(ag, dt, pallets, tol, max_iter)
     springs = range(N_MEMBERS + 1, N_STRUCTURE_ELEMENTS + 1)
     out = {"t": [], "level_displacement": [], "spring_deformation": [], "spring_force": []}
 
     def sample():
         out["t"].append(ops.getTime())
         out["level_displacement"].append(
-            [sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes) for nodes in LEVEL_NODES])
+            [sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes) - u_g[lv]
+             for lv, nodes in enumerate(LEVEL_NODES)])
         out["spring_deformation"].append([ops.eleResponse(e, "deformation")[0] for e in springs])
         out["spring_force"].append([ops.eleResponse(e, "basicForce")[0] for e in springs])
 
@@ -170,16 +206,17 @@ def run(ag, dt, pallets=None, tol=1e-10, max_iter=25):
     NormDispIncr test; a step that fails is retried in substeps and with other algorithms,
     and RuntimeError is raised if none converges.
 
-    Returns the peak over time of |mean ux of each level's nodes| relative to the ground [m],
-    one per level (bottom to top), as seisrack's beam displacement.
+    The rack is first loaded by gravity (``gravity()``). Returns the peak over time of |mean ux
+    of each level's nodes| relative to the ground and to the gravity state [m], one per level
+    (bottom to top), as seisrack's beam displacement.
     """
-    _setup_transient(ag, dt, pallets, tol, max_iter)
+    u_g = _setup_transient(ag, dt, pallets, tol, max_iter)
     peaks = [0.0] * len(LEVEL_NODES)
     for step in range(1, len(ag)):
         if ops.analyze(1, dt) != 0 and not _retry(step * dt, dt, tol, max_iter):
             raise RuntimeError(f"OpenSees did not converge at t = {step * dt:g} s")
         for lv, nodes in enumerate(LEVEL_NODES):
-            d = abs(sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes))
+            d = abs(sum(ops.nodeDisp(n, 1) for n in nodes) / len(nodes) - u_g[lv])
             peaks[lv] = max(peaks[lv], d)
     return peaks
 

@@ -326,7 +326,7 @@ def _header(model: Any, pallets: str, mu: float | None, k_init: float, record: A
             "(see\n  SPRING_MATERIALS); zeroLength deformation u_j - u_i = seisrack's hinge "
             "rotation." if materials else "")
     pd_note = ("\nNOTE: the rack has P-Delta ([second_order]) in seisrack; this script uses a "
-               "Linear\ntransformation and no gravity load, so it leaves P-Delta out.\n"
+               "Linear\ntransformation, so it leaves P-Delta out.\n"
                if getattr(model, "critical_load_factor", None) is not None else "")
     rec = f"\nGround motion: {record.name} (dt {record.dt:g} s), run by `python` this script.\n" \
         if record is not None else ""
@@ -338,9 +338,9 @@ Exported by seisrack {__version__} (`seisrack export opensees`) from {source or 
 {model.mesh.springs.shape[0]} connector springs, {model.n_pallets} pallets.
 Units: SI (m, kg, s, N, Pa).
 
-Use: `python {{this file}}` prints the first periods; `import` it for build(), modal(n) and
-run(ag, dt) (ground acceleration ag [m/s2] sampled at dt [s]; returns the peak level
-displacements [m]).
+Use: `python {{this file}}` prints the first periods; `import` it for build(), modal(n),
+gravity() and run(ag, dt) (gravity first, then the ground acceleration ag [m/s2] sampled at
+dt [s]; returns the peak level displacements [m] from the gravity state).
 
 Modelling choices (as seisrack's compiled model, node for node):
 - members: dispBeamColumn, Elastic section, 3-point Gauss-Legendre, Linear transformation,

@@ -79,13 +79,17 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         upright_below_elements=rm.upright_below_elements,
         upright_above_elements=rm.upright_above_elements,
         member_mass=member_mass, g=spec.g, title=spec.title, critical_load_factor=lam_cr,
-        **_hinges(spec, rm),
+        **_hinges(spec, rm, K, M, r_y),
         pallet_friction_rate=np.array([p.friction_rate for p in spec.pallets], dtype=float),
     ))
 
 
-def _hinges(spec: RackSpec, rm: RackMesh) -> dict[str, np.ndarray]:
-    """Every connection spring as a hinge, with its law (``[hysteresis]``, else elastic)."""
+def _hinges(spec: RackSpec, rm: RackMesh, K: sp.csr_matrix, M: sp.csr_matrix,
+            r_y: FloatArray) -> dict[str, np.ndarray]:
+    """Every connection spring as a hinge, with its law (``[hysteresis]``, else elastic), and
+    its rotation under gravity: a time history starts from the rack standing under its own
+    and its pallets' weight, so a connector already carries its gravity moment. InputError
+    when gravity alone takes a hinge past the elastic branch of its law."""
     from seisrack.model.hinge_law import HingeLaw
 
     mesh = rm.mesh
@@ -108,11 +112,34 @@ def _hinges(spec: RackSpec, rm: RackMesh) -> dict[str, np.ndarray]:
         th_y.append(law.yield_rotation)
     from seisrack.dynamics._hysteresis import HYST_NPAR
 
+    th_g = np.zeros(k.shape[0])
+    if spec.hysteresis.nonlinear and k.size:
+        import scipy.sparse.linalg as spla
+
+        u_g = spla.spsolve(sp.csc_matrix(K), -spec.g * (M @ r_y))
+        ug = np.append(u_g, 0.0)  # index -1: the ground
+        th_g = ug[dofs[:, 0]] - ug[dofs[:, 1]]
+        _check_gravity_elastic(spec, th_g, k, base, np.array(th_y))
     return {"hinge_dofs": dofs.astype(np.int64).reshape(-1, 2), "hinge_k": k.astype(float),
             "hinge_kind": base.astype(np.int64), "hinge_node": node,
             "hinge_law": np.array(laws, dtype=np.int64),
             "hinge_par": np.array(pars, dtype=float).reshape(-1, HYST_NPAR),
-            "hinge_yield_rotation": np.array(th_y, dtype=float)}
+            "hinge_yield_rotation": np.array(th_y, dtype=float),
+            "hinge_rotation_gravity": th_g}
+
+
+def _check_gravity_elastic(spec: RackSpec, th_g: FloatArray, k: FloatArray, base: np.ndarray,
+                           th_y: FloatArray) -> None:
+    over = np.abs(th_g) >= th_y
+    if np.any(over):
+        i = int(np.argmax(np.abs(th_g) / th_y))
+        which = "base" if base[i] else "beam_to_upright"
+        raise InputError(
+            f"hysteresis.{which}", f"elastic branch up to {th_y[i]:.4g} rad",
+            f"a law whose elastic branch holds the gravity rotation {abs(th_g[i]):.4g} rad "
+            f"(moment {abs(k[i] * th_g[i]):.4g} N·m)", source=spec.source,
+            hint="The rack's own and its pallets' weight alone would yield this connection; "
+                 "check the yield moment, the pallet masses and the beam section")
 
 
 def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:

@@ -75,6 +75,8 @@ class FrameModel:
         hinge_law, hinge_par: (n_h,) int law code and (n_h, HYST_NPAR) parameters (elastic
             where ``[hysteresis]`` gives no law).
         hinge_yield_rotation: (n_h,) [rad] end of the elastic branch (``inf``: elastic).
+        hinge_rotation_gravity: (n_h,) [rad] rotation under gravity (the static state a time
+            history starts from; zeros when every connection is linear).
         pallet_friction_rate: (n_pallet,) [s/m] velocity dependence of friction (0: Coulomb).
 
     Second order:
@@ -121,6 +123,7 @@ class FrameModel:
     hinge_law: IntArray | None = None
     hinge_par: FloatArray | None = None
     hinge_yield_rotation: FloatArray | None = None
+    hinge_rotation_gravity: FloatArray | None = None
     pallet_friction_rate: FloatArray | None = None
 
     @property
