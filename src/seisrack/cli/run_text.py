@@ -56,7 +56,8 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
             fa = "" if filt is None else f", filtered {filt[lv]:.3f} m/s²"
             lines.append(f"    level {lv + 1}: displacement {d * 1e3:.3f} mm, "
                          f"acceleration raw {a:.3f} m/s²{fa}")
-    lines.extend(_design_lines(summary.get("design")))
+    lines.extend(_design_lines(summary.get("design"), summary.get("hinges")))
+    lines.extend(_hinge_lines(summary.get("hinges"), summary.get("energy_J") or {}))
     lines.append("")
     if resp.n_pallets:
         lines.append("Pallets (sliding relative to the beam; limit = free distance -x / +x)")
@@ -90,10 +91,17 @@ def format_report(resp: Any, spec: Any, rec: Any, vert: Any, summary: dict[str, 
     return "\n".join(lines)
 
 
-def _design_lines(design: dict[str, Any] | None) -> list[str]:
-    """Peaks of the design quantities (gravity + seismic, elastic) with the member."""
+def _design_lines(design: dict[str, Any] | None,
+                  hinges: dict[str, Any] | None = None) -> list[str]:
+    """Peaks of the design quantities (gravity + seismic, elastic) with the member.
+
+    With nonlinear connections the design operators' connector moment is the elastic k·θ,
+    wrong once a connector yields: the row shows the connectors' hinge moments instead (the
+    moment of their law), with the elastic value named on a note line when it differs.
+    """
     if not design:
         return []
+    conn = [r for r in (hinges or {}).get("hinges", []) if r["kind"] == "connector"]
     rows = [("interstorey drift ratio", "interstorey_drift_ratio", 1e2, "%"),
             ("beam end moment", "beam_end_moment_Nm", 1e-3, "kN·m"),
             ("beam end shear", "beam_end_shear_N", 1e-3, "kN"),
@@ -105,6 +113,14 @@ def _design_lines(design: dict[str, Any] | None) -> list[str]:
         item = design.get(key) or {}
         if not item.get("labels"):
             continue
+        if key == "connector_moment_Nm" and conn:
+            top = max(conn, key=lambda r: (r["peak_moment_Nm"], r["peak_rotation_rad"]))
+            out.append(f"  {'connector moment (hinge law)':<38} "
+                       f"{top['peak_moment_Nm'] * scale:>10.3f} {unit:<5} at {top['hinge']}")
+            if abs(item["max_abs"] - top["peak_moment_Nm"]) > 1e-6 * max(item["max_abs"], 1.0):
+                out.append(f"    elastic k·θ {item['max_abs'] * scale:.3f} {unit} ignores yielding "
+                           "(the design block of summary.json and peaks.csv keep it)")
+            continue
         out.append(f"  {name:<38} {item['max_abs'] * scale:>10.3f} {unit:<5} "
                    f"at {item['max_label']}")
     nm = design.get("upright_n_m") or {}
@@ -113,6 +129,31 @@ def _design_lines(design: dict[str, Any] | None) -> list[str]:
         n_, m_ = nm["at_max_abs_N"][k]
         out.append(f"  {'upright N with concomitant M':<38} N = {n_ / 1e3:.3f} kN, "
                    f"M = {m_ / 1e3:.3f} kN·m at {nm['labels'][k]}")
+    return out
+
+
+def _hinge_lines(hinges: dict[str, Any] | None, energy: dict[str, float]) -> list[str]:
+    """The nonlinear connections: one line per hinge and the hysteretic energy."""
+    if not hinges:
+        return []
+    out = ["", "Connections (nonlinear; rotation from the zero-moment state, gravity included)",
+           f"  {'hinge':<24} {'law':<16} {'peak rot [mrad]':>15} {'peak M [kN·m]':>13} "
+           f"{'residual [mrad]':>15} {'ductility':>9}"]
+    for r in hinges["hinges"]:
+        duct = "-" if r["ductility"] is None else f"{r['ductility']:.2f}"
+        out.append(f"  {r['hinge']:<24} {r['law']:<16} {r['peak_rotation_rad'] * 1e3:>15.2f} "
+                   f"{r['peak_moment_Nm'] * 1e-3:>13.3f} "
+                   f"{r['residual_rotation_rad'] * 1e3:>15.2f} {duct:>9}"
+                   + ("  YIELDED" if r["yielded"] else ""))
+    top = ("" if hinges.get("peak_ductility") is None else
+           f"; largest ductility {hinges['peak_ductility']:.2f} at "
+           f"{hinges['peak_ductility_hinge']}")
+    out.append(f"  {hinges['count']} hinges, {hinges['yielded']} yielded{top}")
+    hyst, e_in = hinges.get("hysteretic_energy_J"), energy.get("input")
+    if hyst is not None:
+        share = (f" = {100 * hyst / e_in:.1f} % of the input energy ({e_in:.4g} J)"
+                 if e_in else "")
+        out.append(f"  hysteretic energy dissipated by the connections: {hyst:.4g} J{share}")
     return out
 
 

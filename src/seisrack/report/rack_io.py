@@ -6,8 +6,8 @@
   netCDF4/HDF5 library: xarray + SciPy are enough to write and read it, and every netCDF tool
   (ncdump, Panoply, MATLAB ``ncread``) opens it. NetCDF3 has no compression and ASCII-only text,
   which is why the unit strings below are UDUNITS/CF spellings (``m s-2``, ``N m``).
-- ``peaks.csv``: one row per quantity (and per level / pallet / upright), with the unit and the
-  time of the peak.
+- ``peaks.csv``: one row per quantity (and per level / pallet / upright / connection hinge),
+  with the unit and the time of the peak.
 - ``summary.json``: the same object as ``seisrack run --json``.
 
 Every file is written to a temporary name in the target folder and then renamed over the final
@@ -29,6 +29,7 @@ import numpy as np
 from seisrack import __version__
 from seisrack.analysis.rack import RackResponse
 from seisrack.dynamics.results import EVENT_KINDS
+from seisrack.report.hinge_io import ENERGY_LONG_NAMES, hinge_peak_rows, hinge_variables
 
 #: the file names seisrack writes into an output folder (nothing else there is touched)
 TIMEHISTORY_FILE = "timehistory.nc"
@@ -160,8 +161,10 @@ def response_dataset(
                                      dtype=np.int8), "1", "kind of contact event",
                 flag_values=np.arange(len(EVENT_KINDS), dtype=np.int8),
                 flag_meanings=" ".join(EVENT_KINDS))
+    hinge_variables(resp, coords, data, var)
     for key, arr in resp.energy.items():
-        data[f"energy_{key}"] = var(("time",), arr, "J", f"cumulative {key} energy")
+        data[f"energy_{key}"] = var(("time",), arr, "J",
+                                    ENERGY_LONG_NAMES.get(key, f"cumulative {key} energy"))
     attrs = {
         "title": title or f"seisrack rack time history, record {resp.record_name}",
         "Conventions": "CF-1.8",
@@ -244,7 +247,8 @@ def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
     """Rows of the peaks table: quantity, level, pallet, upright, value, unit, time_s, note.
 
     ``level``, ``pallet`` and ``upright`` are 1-based, empty when not applicable. Values are
-    peaks of the absolute value except for residuals, limits and utilisations.
+    peaks of the absolute value except for residuals, limits, utilisations and ductilities.
+    With nonlinear connections: ``hinge_*`` rows per hinge (:func:`hinge_io.hinge_peak_rows`).
     """
     t = resp.t
     rows: list[dict[str, Any]] = []
@@ -285,7 +289,11 @@ def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
         for key, _, unit, _ in DESIGN_KEYS:
             item = design[key]
             for lab, val in zip(item["labels"], item.get("peak_abs", []), strict=True):
-                add(key, float(val), unit.replace(" ", "*"), note=f"{lab}, gravity + seismic")
+                add(key, float(val), unit.replace(" ", "*"), note=f"{lab}, gravity + seismic"
+                    + (", ELASTIC k*rotation (see hinge_moment)"
+                       if key == "connector_moment_Nm"
+                       and getattr(resp, "hinges", None) is not None else ""))
+    hinge_peak_rows(resp, add)
     util = resp.fall_utilisation()
     residual = resp.pallet_residual()
     labels = resp.pallet_labels()
