@@ -23,7 +23,8 @@ _OUT_HELP = (
     "folder for the results (created if needed): timehistory.nc (netCDF, all time histories), "
     "peaks.csv, summary.json and, with --plot (the default with --out), "
     "beam_displacement.png, beam_acceleration.png, contact_force.png, pallet_sliding.png, "
-    "sliding_heatmap.png (every level). The data files of these names are overwritten; "
+    "sliding_heatmap.png (every level) and, with nonlinear connections, hinge_loops.png. "
+    "The data files of these names are overwritten; "
     "existing figures only with --force; nothing else in the folder is touched"
 )
 #: [m/s²] a record PGA above this draws a warning (issue #14: implausible input)

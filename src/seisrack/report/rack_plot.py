@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from seisrack.analysis.rack import RackResponse
+from seisrack.report.hinge_plot import HINGE_FIGURES, save_hinge_figures
 from seisrack.report.motion_plot import _axes, save
 
 # quantity -> (attribute, per, scale to the plotted unit, axis label, title, figure name)
@@ -355,13 +356,15 @@ def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 
 
 
 def existing_figures(out_dir: str | Path) -> list[Path]:
-    """The files of :data:`RACK_FIGURES` already present in ``out_dir``."""
-    return [Path(out_dir) / f for f in RACK_FIGURES if (Path(out_dir) / f).exists()]
+    """The files of :data:`RACK_FIGURES` (and ``hinge_loops.png``) already in ``out_dir``."""
+    return [Path(out_dir) / f for f in (*RACK_FIGURES, *HINGE_FIGURES)
+            if (Path(out_dir) / f).exists()]
 
 
 def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, suptitle: str | None = None,
                       force: bool = False) -> list[Path]:
-    """Write the figures of the user's rack (:data:`RACK_FIGURES`, all levels) into ``out_dir``.
+    """Write the figures of the user's rack (:data:`RACK_FIGURES`, all levels; with nonlinear
+    connections also ``hinge_loops.png``) into ``out_dir``.
 
     An existing figure is never overwritten unless ``force``: raises ``InputError`` naming
     ``--force`` before anything is written.
@@ -409,4 +412,4 @@ def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, suptitle: str 
         else:
             ax.set_title("no pallets")
         finish(ax, name)
-    return paths
+    return paths + save_hinge_figures(resp, out, suptitle=suptitle)
