@@ -1,9 +1,12 @@
-"""Contact-state decisions of the Newmark kernel at an instant (source shared by both backends).
+"""Contact-state decisions of the Newmark kernel at an instant, and the end of a Newmark step
+(source shared by both backends).
 
 ``_consistent`` decides which sliders stick or slide at an instant (start of the run, or a
 located event) and computes the consistent accelerations; ``_accel_fixed`` recomputes the
-accelerations from equilibrium for given slider forces. Loaded before ``_kernel.py`` into the
-numba namespace (see ``_kernel_numba.py``); ``docs/theory/stick_slip_engine.md`` §5.
+accelerations from equilibrium for given slider forces; ``_newmark_end`` completes a trial
+step (linear ``_trial`` and nonlinear ``_nl_trial``) once its generalized forces are known.
+Loaded before ``_kernel_hinge.py`` and ``_kernel.py`` into the numba namespace (see
+``_kernel_numba.py``); ``docs/theory/stick_slip_engine.md`` §3 and §5.
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
@@ -27,6 +30,33 @@ def _stuck_index(stuck, n_stuck):
             idx[k] = j
             k += 1
     return idx
+
+
+@_JIT
+def _newmark_end(h, HYt, y, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
+                 q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vn):
+    """End state of an average-acceleration step of length ``h``: Δq = q̂ − HYt·y (``y``: the
+    slider forces, then any hinge corrections; ``HYt`` = K̂⁻¹ [P; Q]ᵀ), the Newmark updates of
+    q̇, q̈, and the sliders' (w, ẇ, ẅ) under the forces ``lam1``; a stuck slider gets exactly
+    its support's velocity (removes round-off drift). ``f`` (n,), ``vn`` (m,) are scratch."""
+    n = q0.shape[0]
+    c0 = 4.0 / (h * h)
+    c1 = 4.0 / h
+    c2 = 2.0 / h
+    _mv(HYt, y, f)
+    for i in range(n):
+        dq = qhat[i] - f[i]
+        q1[i] = q0[i] + dq
+        qd1[i] = c2 * dq - qd0[i]
+        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
+    _mv(P, qd1, vn)
+    for j in range(mass.shape[0]):
+        wdd1[j] = -ag1 + lam1[j] / mass[j]
+        wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
+        w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
+        if stuck[j]:
+            wd1[j] = vn[j]
+        s1[j] = wd1[j] - vn[j]
 
 
 @_JIT

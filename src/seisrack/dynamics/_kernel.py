@@ -29,7 +29,12 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_events.py``
     _record_events  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    from seisrack.dynamics._contact import _accel_fixed, _consistent, _stuck_index
+    from seisrack.dynamics._contact import (
+        _accel_fixed,
+        _consistent,
+        _newmark_end,
+        _stuck_index,
+    )
     from seisrack.dynamics._events import (
         _JIT,
         STATUS_OK,
@@ -73,7 +78,6 @@ def _trial(
     """
     n = kd.shape[0]
     m = mass.shape[0]
-    c0 = 4.0 / (h * h)
     c1 = 4.0 / h
     c2 = 2.0 / h
     # incremental form: K_hat dq = p1 - K q0 + C qd0 + (4/h) qd0 + qdd0 (no cancellation for
@@ -120,23 +124,8 @@ def _trial(
             for c in range(n_stuck):
                 acc += Ainv_cache[a, c] * rhs_s[c]
             lam1[idx[a]] = acc
-    # structure end state
-    _mv(HPt, lam1, f)
-    for i in range(n):
-        dq = qhat[i] - f[i]
-        q1[i] = q0[i] + dq
-        qd1[i] = c2 * dq - qd0[i]
-        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
-    _mv(P, qd1, vnode)
-    vn = vnode
-    for j in range(m):
-        wdd1[j] = -ag1 + lam1[j] / mass[j]
-        wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
-        w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
-        if stuck[j]:
-            # exact zero relative velocity (removes round-off drift)
-            wd1[j] = vn[j]
-        s1[j] = wd1[j] - vn[j]
+    _newmark_end(h, HPt, lam1, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
+                 q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vnode)
     return recomputed
 
 

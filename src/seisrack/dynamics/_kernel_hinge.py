@@ -31,47 +31,14 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_hysteresis.py`` and ``_linalg.py``
     _hyst_trial  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._contact import _newmark_end
     from seisrack.dynamics._events import _JIT
     from seisrack.dynamics._hysteresis import HYST_S_M, HYST_S_THETA, _hyst_trial
-    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv
+    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve_into
 
 STATUS_NEWTON = 4
 _NEWTON_MAX = 60
 _NEWTON_DAMPED = 20  # after this many iterations the steps are halved (breaks branch cycling)
-
-
-@_JIT
-def _solve_inplace(A, x):
-    """Solve A y = x by Gaussian elimination with partial pivoting, overwriting A and x with
-    the factors and y (no allocation: it runs in every Newton iteration)."""
-    k = A.shape[0]
-    for c in range(k):
-        piv = c
-        big = abs(A[c, c])
-        for i in range(c + 1, k):
-            if abs(A[i, c]) > big:
-                big = abs(A[i, c])
-                piv = i
-        if piv != c:
-            for j in range(k):
-                t = A[c, j]
-                A[c, j] = A[piv, j]
-                A[piv, j] = t
-            t = x[c]
-            x[c] = x[piv]
-            x[piv] = t
-        d = A[c, c]
-        for i in range(c + 1, k):
-            f = A[i, c] / d
-            if f != 0.0:
-                for j in range(c + 1, k):
-                    A[i, j] -= f * A[c, j]
-                x[i] -= f * x[c]
-    for c in range(k - 1, -1, -1):
-        acc = x[c]
-        for j in range(c + 1, k):
-            acc -= A[c, j] * x[j]
-        x[c] = acc / A[c, c]
 
 
 @_JIT
@@ -135,12 +102,12 @@ def _nl_trial(
     m = mass.shape[0]
     nh = hk.shape[0]
     nx = m + nh
-    c0 = 4.0 / (h * h)
     c1 = 4.0 / h
     c2 = 2.0 / h
     rhs, qhat, tmp = wn[0], wn[1], wn[2]
     dfree, b, x, zp, R, ds, y = wx[0], wx[1], wx[2], wx[3], wx[4], wx[5], wx[6]
     kt_lin, c_lin = wx[7], wx[8]  # each hinge's branch (tangent, intercept) of the last solve
+    R2 = R.reshape((nx, 1))
     _damp_mul(cd, Cq, diag, qd0, rhs)
     for i in range(n):
         rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
@@ -222,7 +189,7 @@ def _nl_trial(
                 J[m + i, m + k] = GG[m + i, m + k] * zp[k]
             J[m + i, m + i] += 1.0
             R[m + i] = r
-        _solve_inplace(J, R)  # R becomes the Newton step (negated)
+        _solve_into(J, R2)  # R becomes the Newton step (negated)
         step = 0.5 if it >= _NEWTON_DAMPED else 1.0
         conv = True
         for k in range(nx):
@@ -238,23 +205,8 @@ def _nl_trial(
         lam1[j] = x[j]
     for i in range(nh):
         y[m + i] = hz[i]
-    f = tmp
-    _mv(HDt, y, f)
-    for i in range(n):
-        dq = qhat[i] - f[i]
-        q1[i] = q0[i] + dq
-        qd1[i] = c2 * dq - qd0[i]
-        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
-    for j in range(m):
-        wdd1[j] = -ag1 + lam1[j] / mass[j]
-        wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
-        w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
-        vj = 0.0
-        for k in range(n):
-            vj += D[j, k] * qd1[k]
-        if stuck[j]:
-            wd1[j] = vj
-        s1[j] = wd1[j] - vj
+    _newmark_end(h, HDt, y, qhat, q0, qd0, qdd0, D[:m], mass, ag1, lam1, w0, wd0, wdd0, stuck,
+                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, ds)
     return status
 
 

@@ -18,10 +18,17 @@ def _solve(A, B):
     Hand-written (instead of np.linalg) to keep numba compile times short; k is small here
     (number of stuck sliders) or the modal size for non-classical damping only.
     """
-    k = A.shape[0]
-    r = B.shape[1]
-    a = A.copy()
     x = B.copy()
+    _solve_into(A.copy(), x)
+    return x
+
+
+@_JIT
+def _solve_into(a, x):
+    """Solve a y = x in place (``a`` is overwritten by its factors, ``x`` (k, r) by y): no
+    allocation, for the Newton iterations of the nonlinear trial."""
+    k = a.shape[0]
+    r = x.shape[1]
     for c in range(k):
         piv = c
         big = abs(a[c, c])
@@ -52,7 +59,6 @@ def _solve(A, B):
             for i in range(c + 1, k):
                 acc -= a[c, i] * x[i, j]
             x[c, j] = acc / a[c, c]
-    return x
 
 
 @_JIT
