@@ -57,6 +57,8 @@ def test_report_is_self_contained_with_every_section(case, tmp_path):
     text = out.read_text(encoding="utf-8")
     for sec in ("inputs", "elevation", "modal", "record", "histories", "tables", "checks"):
         assert f'<section id="{sec}">' in text
+    # elastic connections: no "Connections" section, the checks keep their number
+    assert '<section id="connections">' not in text and "7. Design checks" in text
     # no external resource: every src is inline, no stylesheet links, no remote scripts
     assert not re.search(r'<(script|img|link|iframe)[^>]+(src|href)="(https?:)?//', text)
     assert "<link" not in text

@@ -8,6 +8,7 @@ import numpy as np
 
 from seisrack import __version__
 from seisrack.report.html import figures as F
+from seisrack.report.html.connections import connections_html
 from seisrack.report.html.style import CSS
 from seisrack.report.html.tables import (
     esc,
@@ -24,7 +25,7 @@ N_WORST = 5
 KNOWN_KEYS = {"record", "g_m_s2", "dt_s", "duration_s", "status", "peaks", "sliding_occurred",
               "pallets_at_risk", "pallets", "simplified_check", "n_events", "n_slip_events",
               "energy_balance_error", "rack", "title", "integration", "basis", "scaling",
-              "outputs", "design_checks", "modal", "report", "seed"}
+              "outputs", "design_checks", "modal", "report", "seed", "hinges"}
 
 
 def _figure(fig_id: str, src: str, caption: str) -> str:
@@ -232,12 +233,18 @@ def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: di
                + peaks_table(summary) + level_table(summary, model.level_y)
                + pallet_table(summary) + "".join(generic_tables(summary, KNOWN_KEYS))
                + "</section>")
+    conn = connections_html(summary, response)
+    if conn:
+        sec.append(f'<section id="connections"><h2>7. Connections (nonlinear)</h2>{conn}'
+                   "</section>")
     if checks is not None:
-        sec.append('<section id="checks"><h2>7. Design checks beside the time history</h2>'
-                   + _checks_html(checks) + "</section>")
+        sec.append(f'<section id="checks"><h2>{8 if conn else 7}. Design checks beside the '
+                   "time history</h2>" + _checks_html(checks) + "</section>")
     verdict = (f"{n_risk} pallet(s) may fall" if n_risk else "no pallet reached its free "
                "distance") + ("; pallets slid" if summary.get("sliding_occurred") else
                               "; no sliding")
+    if summary.get("hinges"):
+        verdict += f"; {summary['hinges']['yielded']} connection hinge(s) yielded"
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>seisrack report: {esc(title)}</title>"
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
