@@ -78,8 +78,14 @@ def modal_analysis(model: Any, n_modes: int | None = None, *, method: Method = "
     """Modes of a :class:`~seisrack.model.FrameModel` with the pallets rigidly attached.
 
     ``n_modes=None`` returns all modes (dense solver). Shapes are normalised with the total mass
-    (``total_mass_sparse()``). ``method``: see :func:`modal_from_matrices`.
+    (``total_mass_sparse()``). ``method``: see :func:`modal_from_matrices`. A 3D rack
+    (:class:`~seisrack.model.frame_model3d.FrameModel3D`) gives a
+    :class:`~seisrack.fe.modal3d.ModalResult3D` (cross-aisle and torsional participation too).
     """
+    if getattr(model, "is_3d", False):
+        from seisrack.fe.modal3d import modal_analysis_3d
+
+        return modal_analysis_3d(model, n_modes, method=method)
     return modal_from_matrices(model.K_sparse, model.total_mass_sparse(), model.r_x, model.r_y,
                                n_modes, method=method)
 

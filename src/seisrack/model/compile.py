@@ -33,7 +33,16 @@ log = logging.getLogger(__name__)
 
 
 def compile_rack(spec: RackSpec) -> FrameModel:
-    """Build the frame model of ``spec``; raises InputError if the frame is a mechanism."""
+    """Build the frame model of ``spec``; raises InputError if the frame is a mechanism.
+
+    A 3D rack (``[geometry] depth`` given) compiles to a
+    :class:`~seisrack.model.frame_model3d.FrameModel3D` instead
+    (:func:`seisrack.model.compile3d.compile_rack_3d`).
+    """
+    if spec.is_3d:
+        from seisrack.model.compile3d import compile_rack_3d
+
+        return compile_rack_3d(spec)  # type: ignore[return-value]
     rm = build_rack_mesh(spec)
     mesh = rm.mesh
     K, M = assemble_sparse(mesh)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +39,8 @@ from seisrack.model.spec import (
 )
 
 _TOP_KEYS = ("title", "g", "material", "sections", "geometry", "connections", "damping",
-             "second_order", "hysteresis", "loading", "pallets")
+             "second_order", "hysteresis", "loading", "pallets", "bracing")
+_PALLET_3D_KEYS = ("depth", "overhang")  # pallet keys of 3D racks (pallets and [loading])
 _LINE_RE = re.compile(r"\(at line (\d+), column (\d+)\)")
 _GEOM_TOL = 1e-9  # m, slack for floating-point geometry comparisons
 
@@ -69,9 +71,11 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     title = root.string("title", "")
     g = root.number("g", DEFAULT_G, positive=True, unit="m/s²")
     material = _material(root.table("material"))
-    sections = _sections(root.table("sections"))
+    three_d = isinstance(root.data.get("geometry"), dict) and "depth" in root.data["geometry"]
+    sections = _sections(root.table("sections"), three_d)
     geometry = _geometry(root.table("geometry"), sections)
-    connections = _connections(root.table("connections"))
+    connections = _connections(root.table("connections"), three_d)
+    bracing = _bracing(root, geometry, sections)
     damping = _damping(root.table("damping", {}))
     second_order = _second_order(root.table("second_order", {}))
     hysteresis = _hysteresis(root.table("hysteresis", {}), connections)
@@ -79,14 +83,24 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     explicit = tuple(
         _pallet(Table(p, f"pallets[{i}]", source), geometry) for i, p in enumerate(raw_pallets)
     )
-    loading = read_loading(root.table("loading"), geometry) if root.has("loading") else None
+    loading, footprint = None, {}
+    if root.has("loading"):
+        lt = root.table("loading")
+        # the 3D keys are read here; the rest of the table by seisrack.model.loading
+        footprint = _footprint(lt, geometry)
+        rest = Table({k: v for k, v in lt.data.items() if k not in _PALLET_3D_KEYS},
+                     lt.path, source)
+        loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
     pallets, labels = place_pallets(loading, geometry, explicit)
+    if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
+        pallets = tuple(replace(p, **{k: v for k, v in footprint.items()
+                                      if getattr(p, k) is None}) for p in pallets)
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
                     title=title, source=source, second_order=second_order,
-                    hysteresis=hysteresis)
+                    hysteresis=hysteresis, bracing=bracing)
 
 
 __all__ = ["check_friction", "load_rack", "rack_from_dict"]
@@ -94,21 +108,42 @@ __all__ = ["check_friction", "load_rack", "rack_from_dict"]
 
 def _material(t: Table) -> Material:
     m = Material(E=t.number("E", positive=True, unit="Pa"),
-                 density=t.number("density", positive=True, unit="kg/m³"))
-    t.finish(("E", "density"))
+                 density=t.number("density", positive=True, unit="kg/m³"),
+                 poisson=t.number("poisson", 0.3, unit="-"))
+    if not -1.0 < m.poisson < 0.5:
+        raise t.error("poisson", m.poisson, "a Poisson's ratio in (-1, 0.5) (steel: 0.3)")
+    t.finish(("E", "density", "poisson"))
     return m
 
 
-def _sections(t: Table) -> dict[str, Section]:
+def _sections(t: Table, three_d: bool = False) -> dict[str, Section]:
     out: dict[str, Section] = {}
     for name in list(t.data):
         s = t.table(name)
-        out[name] = Section(name=name, A=s.number("A", positive=True, unit="m²"),
-                            I=s.number("I", positive=True, unit="m⁴"))
-        s.finish(("A", "I"))
+        if not three_d:
+            out[name] = Section(name=name, A=s.number("A", positive=True, unit="m²"),
+                                I=s.number("I", positive=True, unit="m⁴"))
+            s.finish(("A", "I"))
+            continue
+        out[name] = _section_3d(s, name)
     if not out:
         raise t.error("<name>", {}, "at least one named section, e.g. [sections.beam]")
     return out
+
+
+def _section_3d(s: Table, name: str) -> Section:
+    """A section of a 3D rack: ``I`` and ``Iz`` are the same (down-aisle-plane bending), the
+    others optional here; what the members need is checked by the 3D compiler."""
+    opt = {k: (s.number(k, positive=True, unit="m⁴") if s.has(k) else None)
+           for k in ("I", "Iz", "Iy", "J", "Ip")}
+    if opt["I"] is not None and opt["Iz"] is not None and opt["I"] != opt["Iz"]:
+        raise s.error("Iz", opt["Iz"], f"the same value as I ({opt['I']:g}), or only one of "
+                                       "them (both mean bending in the down-aisle plane)")
+    i_z = opt["I"] if opt["I"] is not None else opt["Iz"]
+    sec = Section(name=name, A=s.number("A", positive=True, unit="m²"),
+                  I=math.nan if i_z is None else i_z, Iy=opt["Iy"], J=opt["J"], Ip=opt["Ip"])
+    s.finish(("A", "I", "Iz", "Iy", "J", "Ip"))
+    return sec
 
 
 def _section_names(t: Table, key: str, n: int, what: str, sections: dict[str, Section]
@@ -149,8 +184,9 @@ def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
         upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
         subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
+        depth=t.number("depth", positive=True, unit="m") if t.has("depth") else None,
     )
-    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions"))
+    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth"))
     return geom
 
 
@@ -170,10 +206,52 @@ def _spring(t: Table, key: str) -> float:
     return float(value)
 
 
-def _connections(t: Table) -> Connections:
-    c = Connections(beam_to_upright=_spring(t, "beam_to_upright"), base=_spring(t, "base"))
-    t.finish(("beam_to_upright", "base"))
+def _connections(t: Table, three_d: bool = False) -> Connections:
+    c = Connections(beam_to_upright=_spring(t, "beam_to_upright"), base=_spring(t, "base"),
+                    base_cross=_spring(t, "base_cross") if three_d and t.has("base_cross")
+                    else None)
+    t.finish(("beam_to_upright", "base") + (("base_cross",) if three_d else ()))
     return c
+
+
+def _bracing(root: Table, geom: Geometry, sections: dict[str, Section]) -> Any:
+    """``[bracing]``: required by a 3D rack, refused by a 2D one."""
+    if geom.depth is None:
+        if root.has("bracing"):
+            raise root.error("bracing", root.raw("bracing"), "no [bracing] table in a 2D rack",
+                             hint="Give [geometry] depth (the upright-frame depth, m) for a "
+                                  "3D rack with braced upright frames")
+        return None
+    from seisrack.model.bracing import read_bracing
+
+    if not root.has("bracing"):
+        raise root.error("bracing", None, "a [bracing] table (a 3D rack needs braced upright "
+                                          "frames)", hint="Add [bracing] with pattern, panel, "
+                                                          "horizontal_section, diagonal_section")
+    return read_bracing(root.table("bracing"), geom.level_y[-1], geom.n_bays, geom.n_levels,
+                        sections)
+
+
+def _footprint(t: Table, geom: Geometry) -> dict[str, float]:
+    """Pallet ``depth`` and ``overhang`` [m] (3D racks), validated against the frame depth."""
+    out: dict[str, float] = {}
+    for key in _PALLET_3D_KEYS:
+        if t.has(key):
+            if geom.depth is None:
+                raise t.error(key, t.raw(key), "no pallet depth or overhang in a 2D rack",
+                              hint="Give [geometry] depth for a 3D rack")
+            out[key] = t.number(key, nonnegative=key == "overhang", positive=key == "depth",
+                                unit="m")
+    depth, over = out.get("depth"), out.get("overhang")
+    if depth is not None and over is not None and over >= depth:
+        raise t.error("overhang", over, f"an overhang >= 0 and < the pallet depth {depth:g} m")
+    if depth is not None and geom.depth is not None:
+        allowed = geom.depth + 2.0 * (over or 0.0)
+        if depth > allowed + _GEOM_TOL:
+            raise t.error("depth", depth, f"a pallet depth <= the frame depth + 2 x overhang = "
+                                          f"{geom.depth:g} + 2 x {over or 0.0:g} = "
+                                          f"{allowed:g} m")
+    return out
 
 
 def _period(t: Table, key: str, value: Any) -> float:
@@ -269,10 +347,12 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
     limit = None if limit_raw is None else check_number(
         limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
     rate = friction_rate(t)
+    fp = _footprint(t, geom)
     t.finish(("mass", "bay", "level", "position", "mu_static", "mu_dynamic", "width",
-              "sliding_limit", "friction_rate"))
+              "sliding_limit", "friction_rate") + _PALLET_3D_KEYS)
     return Pallet(mass=mass, bay=bay, level=level, position=position, mu_static=mu_s,
-                  mu_dynamic=mu_d, width=width, sliding_limit=limit, friction_rate=rate)
+                  mu_dynamic=mu_d, width=width, sliding_limit=limit, friction_rate=rate,
+                  depth=fp.get("depth"), overhang=fp.get("overhang"))
 
 
 def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],

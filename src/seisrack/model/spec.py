@@ -15,6 +15,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Literal
 
 if TYPE_CHECKING:
+    from seisrack.model.bracing import Bracing
     from seisrack.model.hinge_law import HingeLaw
 
 #: Default pallet width along the beam [m] (EUR pallet, 1200 x 800 mm, long side across the beams).
@@ -32,19 +33,35 @@ DampingKind = Literal["stiffness", "rayleigh", "none"]
 
 @dataclass(frozen=True)
 class Material:
-    """Linear elastic material. ``E`` [Pa], ``density`` [kg/m³]."""
+    """Linear elastic material. ``E`` [Pa], ``density`` [kg/m³]; ``poisson`` [-] gives the
+    shear modulus G = E / (2 (1 + ν)) of 3D racks (torsion)."""
 
     E: float
     density: float
+    poisson: float = 0.3
+
+    @property
+    def G(self) -> float:  # noqa: N802
+        return self.E / (2.0 * (1.0 + self.poisson))
 
 
 @dataclass(frozen=True)
 class Section:
-    """A named cross-section: area ``A`` [m²], second moment of area ``I`` [m⁴] (in-plane)."""
+    """A named cross-section: area ``A`` [m²], second moment of area ``I`` [m⁴] (in-plane).
+
+    In a 3D rack ``I`` (alias ``Iz``) is bending in the down-aisle plane (x–y, about the
+    cross-aisle axis: the 2D meaning), ``Iy`` bending in the other principal plane (cross-aisle
+    for an upright, horizontal for a beam), ``J`` the St Venant torsion constant and ``Ip`` the
+    polar moment of area for the torsional inertia (``None``: Iy + Iz). ``I`` is ``nan`` for a
+    3D section that gives only ``A`` (bracing members, which are pin-ended bars).
+    """
 
     name: str
     A: float
     I: float
+    Iy: float | None = None
+    J: float | None = None
+    Ip: float | None = None
 
 
 @dataclass(frozen=True)
@@ -60,6 +77,7 @@ class Geometry:
     beam_sections: tuple[str, ...]
     upright_sections: tuple[str, ...]
     subdivisions: int = DEFAULT_SUBDIVISIONS
+    depth: float | None = None  # upright-frame depth [m]: a 3D rack when given
 
     @property
     def n_bays(self) -> int:
@@ -94,6 +112,11 @@ class Connections:
 
     beam_to_upright: float
     base: float
+    base_cross: float | None = None  # 3D: base plate about the down-aisle axis (None: = base)
+
+    @property
+    def base_cross_k(self) -> float:
+        return self.base if self.base_cross is None else self.base_cross
 
     @staticmethod
     def describe_value(k: float) -> str:
@@ -168,6 +191,8 @@ class Pallet:
     width: float = DEFAULT_PALLET_WIDTH
     sliding_limit: float | None = None
     friction_rate: float = 0.0
+    depth: float | None = None  # 3D racks: pallet depth cross-aisle [m]
+    overhang: float | None = None  # 3D racks: overhang beyond the front and rear beams [m]
 
 
 @dataclass(frozen=True)
@@ -185,6 +210,12 @@ class RackSpec:
     source: str | None = None
     second_order: SecondOrder = field(default_factory=SecondOrder)
     hysteresis: Hysteresis = field(default_factory=Hysteresis)
+    bracing: Bracing | None = None  # 3D racks (geometry.depth given)
+
+    @property
+    def is_3d(self) -> bool:
+        """True when ``[geometry] depth`` is given: a 3D rack (see ``compile_rack_3d``)."""
+        return self.geometry.depth is not None
 
     def beam_section(self, level: int) -> Section:
         """Section of the beams of 0-based ``level``."""

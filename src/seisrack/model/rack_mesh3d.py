@@ -1,0 +1,246 @@
+"""Geometry → 3D mesh of a rack: uprights, front and rear beams, bracing, DOF map and springs.
+
+Global axes: x down-aisle (along the beams), y up, z cross-aisle; the front frame is the plane
+z = 0, the rear frame z = ``depth``. Six DOFs per node ``(ux, uy, uz, rx, ry, rz)``.
+
+- Uprights (beam-columns, ``vecxz`` = +z): local z = global z, so ``Iz`` (the 2D ``I``) is
+  bending in the down-aisle plane and ``Iy`` cross-aisle bending. Nodes at the ``subdivisions``
+  divisions of every storey, at every panel point and at every bracing end (merged when within
+  1e-6 m).
+- Beams (``vecxz`` = +z): a front and a rear beam in every bay and level, stations as in 2D
+  (:func:`seisrack.model.rack_mesh.beam_stations`). A beam end is its own node sharing the
+  upright node's translations and its rotations rx, ry (rigid in those directions) and, for a
+  semi-rigid or pinned connector, owning its rotation rz about the cross-aisle axis, tied to
+  the upright's by a spring (none for pinned); a rigid connector shares rz too.
+- Bases: translations and the twist ry fixed; rz (down-aisle bending) and rx (cross-aisle
+  bending) each fixed (rigid), free with a spring to the ground (semi-rigid: ``base`` and
+  ``base_cross``) or free (pinned).
+- Bracing: pin-ended bars (3D trusses) between upright nodes of each upright frame, and the
+  spine diagonals in the rear plane; eccentricities ignored.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from seisrack.fe.mesh import FloatArray, IntArray
+from seisrack.model.bracing import FRONT
+from seisrack.model.rack_mesh import beam_stations
+from seisrack.model.spec import RackSpec
+
+UPRIGHT, BEAM, BRACING, SPINE = 0, 1, 2, 3
+_Z_AXIS = (0.0, 0.0, 1.0)
+_MERGE = 1e-6  # m
+
+
+@dataclass(frozen=True)
+class Mesh3D:
+    """Array description of a 3D frame (beam-columns, trusses and rotational springs).
+
+    nodes: (n_node, 3) [m]; node_dofs: (n_node, 6) int, -1 = restrained.
+    elements: (n_el, 2) beam-column node pairs with E, G, A, Iy, Iz, J, Ip, density (n_el,) and
+    vecxz (n_el, 3). trusses: (n_tr, 2) node pairs with truss_E, truss_A, truss_density.
+    springs: (n_s, 2) DOF pairs (-1 = ground), spring_k (n_s,) [N·m/rad].
+    """
+
+    nodes: FloatArray
+    node_dofs: IntArray
+    elements: IntArray
+    E: FloatArray
+    G: FloatArray
+    A: FloatArray
+    Iy: FloatArray
+    Iz: FloatArray
+    J: FloatArray
+    Ip: FloatArray
+    density: FloatArray
+    vecxz: FloatArray
+    trusses: IntArray
+    truss_E: FloatArray
+    truss_A: FloatArray
+    truss_density: FloatArray
+    springs: IntArray
+    spring_k: FloatArray
+    n_dof: int
+
+    @property
+    def element_dofs(self) -> IntArray:
+        """(n_el, 12) global DOFs of each beam-column; -1 fixed."""
+        return self.node_dofs[self.elements].reshape(-1, 12)
+
+    @property
+    def truss_dofs(self) -> IntArray:
+        """(n_tr, 6) translation DOFs of each truss; -1 fixed."""
+        return self.node_dofs[self.trusses][:, :, :3].reshape(-1, 6)
+
+    @property
+    def lengths(self) -> FloatArray:
+        d = self.nodes[self.elements[:, 1]] - self.nodes[self.elements[:, 0]]
+        return np.linalg.norm(d, axis=1)
+
+
+@dataclass(frozen=True)
+class RackMesh3D:
+    """The mesh plus the rack bookkeeping the 3D compiler needs.
+
+    ``side`` 0 = front (z = 0), 1 = rear (z = depth). Upright line c, side s is column
+    ``2 c + s``. ``truss_kind``: BRACING or SPINE; ``truss_line``: upright line (bracing) or
+    bay (spine).
+    """
+
+    mesh: Mesh3D
+    element_kind: IntArray
+    element_storey: IntArray
+    element_line: IntArray
+    element_side: IntArray
+    truss_kind: IntArray
+    truss_line: IntArray
+    base_nodes: IntArray  # (n_line, 2)
+    level_nodes: IntArray  # (n_line, 2, n_level)
+    beam_nodes: dict[tuple[int, int, int], IntArray]  # (level, bay, side) -> nodes
+    beam_stations: dict[tuple[int, int], FloatArray]  # (level, bay) -> x from left upright
+
+
+def _upright_heights(spec: RackSpec) -> FloatArray:
+    geo = spec.geometry
+    ys = (0.0, *geo.level_y)
+    pts = [float(y) for s in range(geo.n_levels)
+           for y in np.linspace(ys[s], ys[s + 1], geo.subdivisions + 1)]
+    assert spec.bracing is not None
+    pts += list(spec.bracing.heights)
+    out: list[float] = []
+    for y in sorted(pts):
+        if not out or y - out[-1] > _MERGE:
+            out.append(y)
+    return np.array(out)
+
+
+def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
+    geo, br = spec.geometry, spec.bracing
+    assert geo.depth is not None and br is not None
+    n_lev, n_line = geo.n_levels, geo.n_bays + 1
+    xs, zs = geo.upright_x, (0.0, geo.depth)
+    k_joint = spec.connections.beam_to_upright
+    k_base, k_cross = spec.connections.base, spec.connections.base_cross_k
+    heights = _upright_heights(spec)
+    level_y = np.array(geo.level_y)
+
+    nodes: list[tuple[float, float, float]] = []
+    dofs: list[list[int]] = []
+    n_dof = 0
+
+    def new(k: int) -> list[int]:
+        nonlocal n_dof
+        out = list(range(n_dof, n_dof + k))
+        n_dof += k
+        return out
+
+    el: list[tuple[int, int]] = []
+    props: list[tuple[str, int, int, int, int]] = []  # section, kind, storey, line, side
+    springs: list[tuple[int, int, float]] = []
+    base_nodes = np.zeros((n_line, 2), dtype=np.int64)
+    level_nodes = np.zeros((n_line, 2, n_lev), dtype=np.int64)
+    at_height: dict[tuple[int, int], IntArray] = {}  # (line, side) -> node per height
+
+    def base_rot(k: float) -> int:
+        if math.isinf(k):
+            return -1
+        d = new(1)[0]
+        if k > 0.0:
+            springs.append((d, -1, k))
+        return d
+
+    for c, x in enumerate(xs):
+        for side, z in enumerate(zs):
+            ids = [len(nodes)]
+            base_nodes[c, side] = ids[0]
+            nodes.append((x, 0.0, z))
+            dofs.append([-1, -1, -1, base_rot(k_cross), -1, base_rot(k_base)])
+            for y in heights[1:]:
+                ids.append(len(nodes))
+                nodes.append((x, float(y), z))
+                dofs.append(new(6))
+                storey = int(np.searchsorted(level_y, y - _MERGE))
+                el.append((ids[-2], ids[-1]))
+                props.append((geo.upright_sections[storey], UPRIGHT, storey, c, side))
+            at_height[(c, side)] = np.array(ids, dtype=np.int64)
+            for lev, y in enumerate(level_y):
+                level_nodes[c, side, lev] = ids[int(np.argmin(np.abs(heights - y)))]
+
+    by_member: dict[tuple[int, int], list[float]] = {}
+    for p in spec.pallets:
+        by_member.setdefault((p.level - 1, p.bay - 1), []).append(p.position)
+    b_nodes: dict[tuple[int, int, int], IntArray] = {}
+    b_st: dict[tuple[int, int], FloatArray] = {}
+    for lev in range(n_lev):
+        for bay, span in enumerate(geo.bays):
+            st = beam_stations(span, geo.subdivisions, by_member.get((lev, bay), []))
+            b_st[(lev, bay)] = st
+            for side, z in enumerate(zs):
+                ids = []
+                for i, sx in enumerate(st):
+                    node = len(nodes)
+                    nodes.append((xs[bay] + float(sx), float(level_y[lev]), z))
+                    if i in (0, len(st) - 1):
+                        up = dofs[level_nodes[bay + (i > 0), side, lev]]
+                        if math.isinf(k_joint):
+                            dofs.append(list(up))
+                        else:
+                            rz = new(1)[0]
+                            dofs.append(up[:5] + [rz])
+                            if k_joint > 0.0:
+                                springs.append((up[5], rz, k_joint))
+                    else:
+                        dofs.append(new(6))
+                    ids.append(node)
+                for a, b in zip(ids[:-1], ids[1:], strict=True):
+                    el.append((a, b))
+                    props.append((geo.beam_sections[lev], BEAM, lev, bay, side))
+                b_nodes[(lev, bay, side)] = np.array(ids, dtype=np.int64)
+
+    tr: list[tuple[int, int]] = []
+    tr_props: list[tuple[str, int, int]] = []
+
+    def node_at(c: int, side: int, y: float) -> int:
+        return int(at_height[(c, side)][int(np.argmin(np.abs(heights - y)))])
+
+    for c in range(n_line):
+        for (sa, ya, sb, yb), sec in zip(br.members, br.sections, strict=True):
+            tr.append((node_at(c, sa, ya), node_at(c, sb, yb)))
+            tr_props.append((sec, BRACING, c))
+    rear = 1 - FRONT
+    ys = np.concatenate([[0.0], level_y])
+    for bay in br.spine_bays:
+        for s in br.spine_levels:
+            lo, hi = (bay, bay + 1) if s % 2 == 0 else (bay + 1, bay)
+            tr.append((node_at(lo, rear, ys[s]), node_at(hi, rear, ys[s + 1])))
+            tr_props.append((br.spine_section or "", SPINE, bay))
+
+    secs = spec.sections
+    n_el = len(el)
+    sec_of = [secs[p[0]] for p in props]
+    col = np.array([(s.A, s.Iy or 0.0, s.I, s.J or 0.0,
+                     s.Ip if s.Ip is not None else (s.Iy or 0.0) + s.I) for s in sec_of],
+                   dtype=float).reshape(n_el, 5)
+    mat = spec.material
+    mesh = Mesh3D(
+        nodes=np.array(nodes, dtype=float), node_dofs=np.array(dofs, dtype=np.int64),
+        elements=np.array(el, dtype=np.int64).reshape(-1, 2), E=np.full(n_el, mat.E),
+        G=np.full(n_el, mat.G), A=col[:, 0].copy(), Iy=col[:, 1].copy(), Iz=col[:, 2].copy(),
+        J=col[:, 3].copy(), Ip=col[:, 4].copy(), density=np.full(n_el, mat.density),
+        vecxz=np.tile(np.array(_Z_AXIS), (n_el, 1)),
+        trusses=np.array(tr, dtype=np.int64).reshape(-1, 2), truss_E=np.full(len(tr), mat.E),
+        truss_A=np.array([secs[p[0]].A for p in tr_props], dtype=float),
+        truss_density=np.full(len(tr), mat.density),
+        springs=np.array([s[:2] for s in springs], dtype=np.int64).reshape(-1, 2),
+        spring_k=np.array([s[2] for s in springs], dtype=float), n_dof=n_dof)
+    arr = np.array([p[1:] for p in props], dtype=np.int64).reshape(-1, 4)
+    tarr = np.array([p[1:] for p in tr_props], dtype=np.int64).reshape(-1, 2)
+    return RackMesh3D(mesh=mesh, element_kind=arr[:, 0].copy(),
+                      element_storey=arr[:, 1].copy(), element_line=arr[:, 2].copy(),
+                      element_side=arr[:, 3].copy(), truss_kind=tarr[:, 0].copy(),
+                      truss_line=tarr[:, 1].copy(), base_nodes=base_nodes,
+                      level_nodes=level_nodes, beam_nodes=b_nodes, beam_stations=b_st)
