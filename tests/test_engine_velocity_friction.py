@@ -147,3 +147,23 @@ def test_rate_too_steep_for_the_step_is_refused():
     # dt g a (mu_s - mu_d) / 2 = 7.4: the discrete slide would not be unique
     with pytest.raises(InputError, match=r"friction_rate\[0\].*rate < 1359 s/m"):
         _run(0.001, rate=1e4)
+
+
+def test_rack_names_the_pallet_whose_rate_is_too_steep():
+    from pathlib import Path
+
+    from seisrack.analysis import run_rack
+    from seisrack.model import compile_rack, load_rack
+    from seisrack.motion.records import load_builtin_record
+
+    text = (Path(__file__).resolve().parents[1] / "examples" / "paper_rack.toml").read_text()
+    text = text.replace("mu_dynamic = 0.6", "mu_dynamic = 0.45\nfriction_rate = 1e4")
+    path = Path(__file__).resolve().parent / "_tmp_vel_rack.toml"
+    try:
+        path.write_text(text)
+        model = compile_rack(load_rack(path))
+    finally:
+        path.unlink()
+    assert np.all(model.pallet_friction_rate == 1e4)
+    with pytest.raises(InputError, match=r"friction_rate of pallet [1-4] \(level 1\).*rate <"):
+        run_rack(model, load_builtin_record("elcentro_1940_ns"), dt=0.005)

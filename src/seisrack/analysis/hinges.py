@@ -99,3 +99,38 @@ def hinge_response(model: FrameModel, hist: TimeHistory) -> HingeResponse | None
         law=tuple(_LAW_NAMES[int(c)] for c in law),
         rotation=hist.hinge_rotation, moment=hist.hinge_moment,
         yield_rotation=np.asarray(model.hinge_yield_rotation, dtype=float))
+
+
+def nonlinear_connector_design(design: dict, hinges: HingeResponse) -> None:
+    """Replace the elastic k·θ connector moments of a design summary (``connector_moment_Nm``,
+    from the linear recovery operators) by the hinge laws' moments, in place.
+
+    The design convention is the beam's member convention: the connector moment is
+    ``side · M`` with ``side`` +1 at a beam's left end and −1 at its right end, and ``M`` the
+    hinge moment (rotation = beam end minus upright). Values come from the kept samples.
+    """
+    entry = design.get("connector_moment_Nm")
+    if not entry or not entry.get("labels"):
+        return
+    col = {lab: i for i, lab in enumerate(hinges.labels)}
+    rows = []
+    for lab in entry["labels"]:
+        lev, bay, end = lab.split("-")
+        i = col.get(f"connector {lev} {bay} {end}")
+        if i is None:
+            return  # not every connector is a hinge: keep the elastic entry
+        rows.append((1.0 if end == "left" else -1.0) * hinges.moment[:, i])
+    total = np.column_stack(rows)
+    grav = total[0]
+    seis = total - grav
+    peak = np.max(np.abs(total), axis=0)
+    k = int(np.argmax(peak))
+    entry.update({
+        "description": "moment of the beam-to-upright connector from its moment-rotation law "
+                       "(nonlinear connectors; member convention of the beam; over the kept "
+                       "samples)",
+        "gravity": grav.tolist(), "seismic_max": seis.max(axis=0).tolist(),
+        "seismic_min": seis.min(axis=0).tolist(), "peak_abs": peak.tolist(),
+        "seismic_peak_abs": np.max(np.abs(seis), axis=0).tolist(),
+        "max_abs": float(peak[k]), "max_label": entry["labels"][k],
+    })

@@ -172,9 +172,17 @@ def run_rack(
         method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
     tracker = PeakTracker(ops, P, pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
-    hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
-                    save_every=save_every, on_chunk=tracker, track_energy=track_energy,
-                    max_memory=max_memory, hinges=hinges)
+    try:
+        hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
+                        save_every=save_every, on_chunk=tracker, track_energy=track_energy,
+                        max_memory=max_memory, hinges=hinges)
+    except InputError as exc:
+        if not exc.field.startswith("sliders.friction_rate["):
+            raise
+        j = int(exc.field.split("[")[1].rstrip("]"))
+        raise InputError(f"friction_rate of pallet {j + 1} (level {pallet_level[j] + 1})",
+                         exc.value, exc.allowed, source=getattr(model, "title", None) or None,
+                         hint=exc.hint) from None
     if (hist.method == "newmark") != newmark:  # pragma: no cover - guards the rule above
         raise SolverError(f"run_rack expected the {'newmark' if newmark else 'exact'} "
                           f"method but the engine used {hist.method}")

@@ -234,9 +234,13 @@ class RackResponse:
 
     def design_peaks(self) -> dict[str, Any] | None:
         """Design quantities per member and as peaks (see :func:`design_summary`)."""
+        from seisrack.analysis.hinges import nonlinear_connector_design
         from seisrack.analysis.peaks import design_summary
 
-        return design_summary(self)
+        out = design_summary(self)
+        if out is not None and self.hinges is not None:
+            nonlinear_connector_design(out, self.hinges)
+        return out
 
     def _level_peak(self, name: str) -> np.ndarray:
         """(n_level,) peak |value| of a per-level history over every analysis step."""

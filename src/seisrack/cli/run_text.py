@@ -95,9 +95,9 @@ def _design_lines(design: dict[str, Any] | None,
                   hinges: dict[str, Any] | None = None) -> list[str]:
     """Peaks of the design quantities (gravity + seismic, elastic) with the member.
 
-    With nonlinear connections the design operators' connector moment is the elastic k·θ,
-    wrong once a connector yields: the row shows the connectors' hinge moments instead (the
-    moment of their law), with the elastic value named on a note line when it differs.
+    With nonlinear connections the design summary's connector moment is the moment of the
+    connectors' law (:func:`~seisrack.analysis.hinges.nonlinear_connector_design`), and the
+    row says so.
     """
     if not design:
         return []
@@ -114,13 +114,7 @@ def _design_lines(design: dict[str, Any] | None,
         if not item.get("labels"):
             continue
         if key == "connector_moment_Nm" and conn:
-            top = max(conn, key=lambda r: (r["peak_moment_Nm"], r["peak_rotation_rad"]))
-            out.append(f"  {'connector moment (hinge law)':<38} "
-                       f"{top['peak_moment_Nm'] * scale:>10.3f} {unit:<5} at {top['hinge']}")
-            if abs(item["max_abs"] - top["peak_moment_Nm"]) > 1e-6 * max(item["max_abs"], 1.0):
-                out.append(f"    elastic k·θ {item['max_abs'] * scale:.3f} {unit} ignores yielding "
-                           "(the design block of summary.json and peaks.csv keep it)")
-            continue
+            name = "connector moment (hinge law)"
         out.append(f"  {name:<38} {item['max_abs'] * scale:>10.3f} {unit:<5} "
                    f"at {item['max_label']}")
     nm = design.get("upright_n_m") or {}

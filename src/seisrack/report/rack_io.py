@@ -290,7 +290,7 @@ def peak_rows(resp: RackResponse) -> list[dict[str, Any]]:
             item = design[key]
             for lab, val in zip(item["labels"], item.get("peak_abs", []), strict=True):
                 add(key, float(val), unit.replace(" ", "*"), note=f"{lab}, gravity + seismic"
-                    + (", ELASTIC k*rotation (see hinge_moment)"
+                    + (", moment of the hinge law (kept samples)"
                        if key == "connector_moment_Nm"
                        and getattr(resp, "hinges", None) is not None else ""))
     hinge_peak_rows(resp, add)
