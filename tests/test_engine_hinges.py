@@ -265,3 +265,13 @@ def test_gravity_that_yields_a_connection_is_refused():
     with pytest.raises(InputError, match="hysteresis.beam_to_upright") as exc:
         compile_rack(rack_from_dict(d))
     assert "gravity rotation" in str(exc.value)
+
+
+def test_hinge_peaks_do_not_depend_on_decimation():
+    model = _nonlinear_rack(0.5)
+    rec = _record(8.0, 2.0)
+    full = run_rack(model, rec, dt=0.005).hinges.peaks()
+    dec = run_rack(model, rec, dt=0.005, save_every=7).hinges.peaks()
+    for a, b in zip(full, dec, strict=True):
+        assert b["peak_rotation_rad"] == pytest.approx(a["peak_rotation_rad"], rel=1e-12)
+        assert b["peak_moment_Nm"] == pytest.approx(a["peak_moment_Nm"], rel=1e-12)

@@ -33,19 +33,26 @@ class HingeResponse:
     rotation: np.ndarray
     moment: np.ndarray
     yield_rotation: np.ndarray
+    peak_rotation: np.ndarray | None = None  # (n_h,) over every analysis step
+    peak_moment: np.ndarray | None = None
 
     def peaks(self) -> list[dict]:
-        """Per hinge: peak |rotation|, |moment|, residual rotation, ductility demand."""
+        """Per hinge: peak |rotation|, |moment| (over every analysis step when the run tracked
+        them, else over the kept samples), residual rotation, ductility demand."""
         out = []
         for i, lab in enumerate(self.labels):
             th = self.rotation[:, i]
             mom = self.moment[:, i]
             peak = float(np.max(np.abs(th))) if th.size else 0.0
+            if self.peak_rotation is not None:
+                peak = max(peak, float(self.peak_rotation[i]))
             ty = float(self.yield_rotation[i])
             out.append({
                 "hinge": lab, "kind": self.kind[i], "law": self.law[i],
                 "peak_rotation_rad": peak,
-                "peak_moment_Nm": float(np.max(np.abs(mom))) if mom.size else 0.0,
+                "peak_moment_Nm": max(float(np.max(np.abs(mom))) if mom.size else 0.0,
+                                      0.0 if self.peak_moment is None
+                                      else float(self.peak_moment[i])),
                 "residual_rotation_rad": float(th[-1]) if th.size else 0.0,
                 "ductility": peak / ty if np.isfinite(ty) and ty > 0 else None,
                 "yielded": bool(np.isfinite(ty) and peak > ty * (1 + 1e-9)),
@@ -86,7 +93,24 @@ def hinge_labels(model: FrameModel) -> tuple[str, ...]:
     return tuple(labels)
 
 
-def hinge_response(model: FrameModel, hist: TimeHistory) -> HingeResponse | None:
+class HingePeaks:
+    """``on_chunk`` companion: peak |rotation| and |moment| of every hinge over every step
+    (the kept histories may be decimated with ``save_every``)."""
+
+    def __init__(self, hinges: Hinges, phi: np.ndarray) -> None:
+        self.Q = hinges.operator(phi)  # noqa: N806
+        self.theta0 = hinges.theta0
+        self.rotation = np.zeros(hinges.count)
+        self.moment = np.zeros(hinges.count)
+
+    def __call__(self, chunk) -> None:  # noqa: ANN001
+        th = chunk.q @ self.Q.T + self.theta0
+        np.maximum(self.rotation, np.max(np.abs(th), axis=0), out=self.rotation)
+        np.maximum(self.moment, np.max(np.abs(chunk.hinge_moment), axis=0), out=self.moment)
+
+
+def hinge_response(model: FrameModel, hist: TimeHistory,
+                   full: HingePeaks | None = None) -> HingeResponse | None:
     """The run's hinge histories (None when the run had no nonlinear hinges)."""
     if hist.hinge_operator is None or hist.hinge_moment is None \
             or hist.hinge_moment.shape[1] == 0:
@@ -98,7 +122,9 @@ def hinge_response(model: FrameModel, hist: TimeHistory) -> HingeResponse | None
         kind=tuple("base" if k == BASE_PLATE else "connector" for k in model.hinge_kind),
         law=tuple(_LAW_NAMES[int(c)] for c in law),
         rotation=hist.hinge_rotation, moment=hist.hinge_moment,
-        yield_rotation=np.asarray(model.hinge_yield_rotation, dtype=float))
+        yield_rotation=np.asarray(model.hinge_yield_rotation, dtype=float),
+        peak_rotation=None if full is None else full.rotation.copy(),
+        peak_moment=None if full is None else full.moment.copy())
 
 
 def nonlinear_connector_design(design: dict, hinges: HingeResponse) -> None:

@@ -16,7 +16,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from seisrack.analysis.hinges import hinge_response, rack_hinges
+from seisrack.analysis.hinges import HingePeaks, hinge_response, rack_hinges
 from seisrack.analysis.peaks import (
     PeakTracker,
     RackOperators,
@@ -172,9 +172,16 @@ def run_rack(
         method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
     tracker = PeakTracker(ops, P, pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
+    hpk = None if hinges is None else HingePeaks(hinges, bas.phi)
+
+    def on_chunk(chunk) -> None:  # noqa: ANN001
+        tracker(chunk)
+        if hpk is not None:
+            hpk(chunk)
+
     try:
         hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
-                        save_every=save_every, on_chunk=tracker, track_energy=track_energy,
+                        save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
                         max_memory=max_memory, hinges=hinges)
     except InputError as exc:
         if not exc.field.startswith("sliders.friction_rate["):
@@ -203,7 +210,7 @@ def run_rack(
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
                    beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx],
-                   hinges=hinge_response(model, hist))
+                   hinges=hinge_response(model, hist, hpk))
 
 
 def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
