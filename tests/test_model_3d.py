@@ -6,8 +6,9 @@ cross-aisle planes and have no stiffness along x, so they enter only through the
 model of the same rack is one plane frame carrying both frames: every member's A and I and
 every connector and base stiffness doubled (as ``examples/warehouse_rack.toml`` explains), the
 same pallets. The two must give the same down-aisle periods up to the bracing's mass, kept
-small here (50 mm² bars, 18 kg for Z, about 1 % of the moving mass in x, stiff enough that the first
-cross-aisle period is below half the first down-aisle one). Measured: within 0.16 % (Z), 0.23 % (X).
+small here (50 mm² bars, 18 kg for Z, about 1 % of the moving mass in x, stiff enough that
+the first cross-aisle period is below half the first down-aisle one). Measured: within 0.16 %
+(Z), 0.23 % (X).
 """
 
 from __future__ import annotations
@@ -166,6 +167,8 @@ def test_time_history_refused_for_3d():
     with pytest.raises(InputError, match="use seisrack modal"):
         require_2d(compile_rack(spec))
     require_2d(rack_from_dict(equivalent_2d(rack_3d())))  # 2D: no error
+    with pytest.raises(InputError, match="use seisrack modal"):
+        compile_rack(spec).pallet_dof  # noqa: B018  (what the 2D time history asks first)
 
 
 def test_spine_and_loading_footprint():

@@ -31,19 +31,22 @@ from seisrack.model.spec import Connections, RackSpec
 
 log = logging.getLogger(__name__)
 
-RUN_3D_MESSAGE = "3D time histories are not available yet; use seisrack modal"
+RUN_3D_MESSAGE = ("3D time histories are not available yet; use seisrack modal (a 3D rack "
+                  "supports modal analysis only for now)")
 
 
-def require_2d(spec_or_model: object, field: str = "geometry.depth") -> None:
-    """Raise InputError for a 3D rack (spec or compiled model) where only 2D is supported,
-    e.g. at the top of a time history (``seisrack run``)."""
-    is_3d = getattr(spec_or_model, "is_3d", False)
+def require_2d(spec_or_model: object, field: str = "geometry.depth",
+               depth: float | None = None) -> None:
+    """Raise InputError for a 3D rack (spec, compiled model or, with ``depth``, its mesh)
+    where only 2D is supported, e.g. at the top of a time history (``seisrack run``)."""
+    is_3d = depth is not None or getattr(spec_or_model, "is_3d", False)
     if is_3d:
-        depth = getattr(spec_or_model, "depth", None)
+        if depth is None:
+            depth = getattr(spec_or_model, "depth", None)
         if depth is None:
             depth = spec_or_model.geometry.depth  # type: ignore[attr-defined]
-        raise InputError(field, depth, "a 2D rack (no [geometry] depth) for time histories",
-                         hint=RUN_3D_MESSAGE)
+        raise InputError(field, depth, "a 2D rack (no [geometry] depth) for time histories, "
+                         "reports and exports", hint=RUN_3D_MESSAGE)
 
 
 def compile_rack_3d(spec: RackSpec) -> FrameModel3D:

@@ -6,12 +6,14 @@ Only free DOFs appear in the matrices. Nothing here is mutated after compilation
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from seisrack.fe.mesh import FloatArray, IntArray
+from seisrack.model.frame_model import FrameModel
 from seisrack.model.rack_mesh3d import Mesh3D
 
 
@@ -86,6 +88,16 @@ class FrameModel3D:
 
     is_3d = True
 
+    def __getattr__(self, name: str) -> Any:
+        # Only reached when normal lookup fails: a 2D-only attribute (pallet_dof, level_dofs,
+        # hinge_dofs, ...) asked by the 2D time history, report or export stops with a clear
+        # InputError instead of a traceback (see seisrack.model.compile3d.require_2d).
+        if name in _2D_ONLY:
+            from seisrack.model.compile3d import require_2d
+
+            require_2d(self)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
     @property
     def n_dof(self) -> int:
         return int(self.K_sparse.shape[0])
@@ -115,3 +127,8 @@ class FrameModel3D:
         Mt.sum_duplicates()
         Mt.sort_indices()
         return Mt
+
+
+_2D_ONLY = frozenset(f.name for f in fields(FrameModel)) - frozenset(
+    f.name for f in fields(FrameModel3D)) | {"total_mass_matrix", "K", "M", "C",
+                                             "nonlinear_hinges", "elements"}

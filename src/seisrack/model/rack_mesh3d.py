@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -65,6 +66,15 @@ class Mesh3D:
     springs: IntArray
     spring_k: FloatArray
     n_dof: int
+
+    def __getattr__(self, name: str) -> Any:
+        # 2D-only mesh attributes (I, direction_cosines, ...): a clear InputError for 2D code
+        # handed a 3D rack (e.g. the OpenSees export), not a traceback.
+        if name in ("I", "direction_cosines", "ground_spring_k", "n_el"):
+            from seisrack.model.compile3d import require_2d
+
+            require_2d(self, depth=float(np.ptp(self.nodes[:, 2])))
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def element_dofs(self) -> IntArray:
