@@ -49,6 +49,7 @@ def plot_frame_3d(model: Any, ax: Any = None, *, color: str = "0.6") -> Any:
     ax.plot(b[:, 0], b[:, 2], b[:, 1], "k^", ms=5, ls="none")
     ext = np.ptp(model.mesh.nodes, axis=0)
     ax.set_box_aspect((ext[0], max(ext[2], 0.2 * ext.max()), ext[1]))  # x, z, y: true shape
+    ax.locator_params(axis="y", nbins=3)  # matplotlib's y is the rack's z (depth): few ticks
     ax.set_xlabel("x down-aisle [m]")
     ax.set_ylabel("z cross-aisle [m]")
     ax.set_zlabel("y [m]")
