@@ -1,4 +1,5 @@
-"""Closed-form modal propagation and its exact work integrals (exact kernel, part 1 of 3).
+"""Closed-form modal propagation (the trial step) and its exact work integrals (exact kernel,
+part 1 of 3).
 
 Source shared by the numba and pure-Python backends (see :mod:`seisrack.dynamics.kernels`):
 executed after ``_events.py`` and ``_kernel.py`` in one namespace by ``_kernel_numba.py``.
@@ -63,35 +64,121 @@ def _mode_matrices(nu2, cc, h, E):
 
 
 @_JIT
-def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
-    """Exact modal step: loads g linear from g0 to g1 over h; E from ``_mode_matrices(h)``."""
-    for k in range(nu2.shape[0]):
+def _trial_exact(h, Eh, psi, psiT, nu2, cc, P, gpat, mass, mud, on_struct, stuck, sig,
+                 eta0, etad0, w0, wd0, ser0, ser1, ag0, ag1, N0, N1, g0, g1,
+                 eta1, etad1, w1, wd1, lam1, s1, etadd, x0, x1, xd1, xdd, fq, fresh):
+    """Exact step of length h in a fixed contact state (E = propagator for h).
+
+    ``fresh``: g0 and x0 = Ψ η0 already hold the start state's values (the previous
+    sub-step's end, same configuration and contact state): they are not recomputed.
+    A leaf (the modal loads, the closed-form modal step and the products with Ψ written out,
+    each sum in dot-product order): numba then drops the reference counting of its ~35
+    array arguments, which a call to another compiled function keeps (an atomic increment
+    and decrement per array and call: most of this step's cost)."""
+    n = nu2.shape[0]
+    m = mass.shape[0]
+    npat = ser0.shape[0]
+    if not fresh:  # g0 = _loads(t0), x0 = Ψ η0
+        for i in range(n):
+            fq[i] = 0.0
+        for j in range(m):
+            if on_struct[j]:
+                f = -mass[j] * ag0 if stuck[j] else mud[j] * N0[j] * sig[j]
+                if f != 0.0:
+                    for i in range(n):
+                        fq[i] += P[j, i] * f
+        for k in range(n):
+            acc = 0.0
+            for c in range(npat):
+                acc += gpat[k, c] * ser0[c]
+            g0[k] = acc
+            x0[k] = 0.0
+        for i in range(n):
+            f = fq[i]
+            for k in range(n):
+                g0[k] += psi[i, k] * f
+        for k in range(n):
+            e = eta0[k]
+            for i in range(n):
+                x0[i] += psiT[k, i] * e
+    # g1 = _loads(t1)
+    for i in range(n):
+        fq[i] = 0.0
+    for j in range(m):
+        if on_struct[j]:
+            f = -mass[j] * ag1 if stuck[j] else mud[j] * N1[j] * sig[j]
+            if f != 0.0:
+                for i in range(n):
+                    fq[i] += P[j, i] * f
+    for k in range(n):
+        acc = 0.0
+        for c in range(npat):
+            acc += gpat[k, c] * ser1[c]
+        g1[k] = acc
+    for i in range(n):
+        f = fq[i]
+        for k in range(n):
+            g1[k] += psi[i, k] * f
+    # exact modal step, loads linear from g0 to g1 over h (particular part A + B τ,
+    # homogeneous part through E), then the accelerations and Ψ (η1, η̇1, η̈1)
+    for k in range(n):
         s = (g1[k] - g0[k]) / h
         B = s / nu2[k]
         A = (g0[k] - cc[k] * B) / nu2[k]
         y = eta0[k] - A
         yd = etad0[k] - B
-        eta1[k] = A + B * h + E[k, 0] * y + E[k, 1] * yd
-        etad1[k] = B + E[k, 2] * y + E[k, 3] * yd
-
-
-@_JIT
-def _sliding_modal_load(psi, P, mud, sig, Na, Nb, a, b, on_struct, stuck, fq, out):
-    """out = Ψᵀ Σ_j P_jᵀ c_j over the sliders sliding on the structure, with
-    c_j = -mu_d,j σ_j (a Na_j + b Nb_j) (the friction force, or its slope in time)."""
-    r = fq.shape[0]
-    for i in range(r):
-        fq[i] = 0.0
-    for j in range(mud.shape[0]):
-        if on_struct[j] and not stuck[j]:
-            c = -mud[j] * sig[j] * (a * Na[j] + b * Nb[j])
-            for i in range(r):
-                fq[i] += P[j, i] * c
-    for k in range(out.shape[0]):
-        acc = 0.0
-        for i in range(r):
-            acc += psi[i, k] * fq[i]
-        out[k] = acc
+        eta1[k] = A + B * h + Eh[k, 0] * y + Eh[k, 1] * yd
+        etad1[k] = B + Eh[k, 2] * y + Eh[k, 3] * yd
+        etadd[k] = g1[k] - cc[k] * etad1[k] - nu2[k] * eta1[k]
+        x1[k] = 0.0
+        xd1[k] = 0.0
+        xdd[k] = 0.0
+    for k in range(n):
+        e = eta1[k]
+        ed = etad1[k]
+        edd = etadd[k]
+        for i in range(n):
+            x1[i] += psiT[k, i] * e
+            xd1[i] += psiT[k, i] * ed
+            xdd[i] += psiT[k, i] * edd
+    for j in range(m):
+        if stuck[j]:
+            d0 = 0.0
+            d1 = 0.0
+            v1 = 0.0
+            a1_ = 0.0
+            if on_struct[j]:
+                for i in range(n):
+                    p = P[j, i]
+                    d0 += p * x0[i]
+                    d1 += p * x1[i]
+                    v1 += p * xd1[i]
+                    a1_ += p * xdd[i]
+            w1[j] = w0[j] + (d1 - d0)
+            wd1[j] = v1
+            lam1[j] = mass[j] * (a1_ + ag1)
+            s1[j] = 0.0
+        else:
+            lam0 = -mud[j] * N0[j] * sig[j]
+            lam1[j] = -mud[j] * N1[j] * sig[j]
+            a0 = -ag0 + lam0 / mass[j]
+            a1_ = -ag1 + lam1[j] / mass[j]
+            wd1[j] = wd0[j] + 0.5 * h * (a0 + a1_)
+            w1[j] = w0[j] + h * wd0[j] + h * h * (2.0 * a0 + a1_) / 6.0
+            v1 = 0.0
+            if on_struct[j]:
+                for i in range(n):
+                    v1 += P[j, i] * xd1[i]
+            s1[j] = wd1[j] - v1
+    # every array's last use here, in the one exit block: numba's reference-count pruning
+    # then removes the increments and decrements of the arguments (see the docstring)
+    return (Eh.shape[0] + psi.shape[0] + psiT.shape[0] + nu2.shape[0] + cc.shape[0]
+            + P.shape[0] + gpat.shape[0] + mass.shape[0] + mud.shape[0] + on_struct.shape[0]
+            + stuck.shape[0] + sig.shape[0] + eta0.shape[0] + etad0.shape[0] + w0.shape[0]
+            + wd0.shape[0] + ser0.shape[0] + ser1.shape[0] + N0.shape[0] + N1.shape[0]
+            + g0.shape[0] + g1.shape[0] + eta1.shape[0] + etad1.shape[0] + w1.shape[0]
+            + wd1.shape[0] + lam1.shape[0] + s1.shape[0] + etadd.shape[0] + x0.shape[0]
+            + x1.shape[0] + xd1.shape[0] + xdd.shape[0] + fq.shape[0])
 
 
 @_JIT
@@ -113,8 +200,36 @@ def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_s
     e_d = 0.0
     e_f = 0.0
     # sliding forces on the structure, λ_j(τ) = l0_j + ls_j τ, as modal loads f0 + fs τ
-    _sliding_modal_load(psi, P, mud, sig, N0, N0, 1.0, 0.0, on_struct, stuck, fq, f0)
-    _sliding_modal_load(psi, P, mud, sig, N1, N0, 1.0 / h, -1.0 / h, on_struct, stuck, fq, fs)
+    # (written out so that this function stays a leaf, see ``_trial_exact``: a call to
+    # another compiled function keeps numba's reference counting of every array argument;
+    # nothing to add when every slider on the structure sticks, the usual case)
+    any_sliding = False
+    for j in range(m):
+        if on_struct[j] and not stuck[j]:
+            any_sliding = True
+    for k in range(n):
+        f0[k] = 0.0
+        fs[k] = 0.0
+    if any_sliding:
+        for side in range(2):
+            a = 1.0 if side == 0 else 1.0 / h
+            b = 0.0 if side == 0 else -1.0 / h
+            for i in range(n):
+                fq[i] = 0.0
+            for j in range(m):
+                if on_struct[j] and not stuck[j]:
+                    Na = N0[j] if side == 0 else N1[j]
+                    c = -mud[j] * sig[j] * (a * Na + b * N0[j])
+                    for i in range(n):
+                        fq[i] += P[j, i] * c
+            for i in range(n):
+                f = fq[i]
+                if side == 0:
+                    for k in range(n):
+                        f0[k] += psi[i, k] * f
+                else:
+                    for k in range(n):
+                        fs[k] += psi[i, k] * f
     for k in range(n):
         c = cc[k]
         w = nu2[k]
@@ -143,9 +258,10 @@ def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_s
             e_d += (c * B * B * h + 2.0 * c * B * (y1 - y0)
                     + cw11 * y0 * y0 + 2.0 * cw12 * y0 * yd0 + cw22 * yd0 * yd0)
         # sliding forces on the structure: their power leaves the input, enters friction
-        work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
-        e_in += work
-        e_f += work
+        if any_sliding:
+            work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
+            e_in += work
+            e_f += work
     for j in range(m):
         if stuck[j]:
             continue  # stuck on the structure: inside g; stuck on the ground: no motion
