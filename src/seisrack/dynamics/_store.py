@@ -45,6 +45,8 @@ class Kept:
         if sel.size == 0:
             return
         loc = sel - start
+        if loc[-1] - loc[0] == loc.size - 1:  # every step (save_every=1): a slice, no gather
+            loc = slice(int(loc[0]), int(loc[-1]) + 1)
         a, b = self.count, self.count + sel.size
         for dst, src in zip(
             (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck, self.energy),
