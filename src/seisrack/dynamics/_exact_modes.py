@@ -64,83 +64,88 @@ def _mode_matrices(nu2, cc, h, E):
 
 
 @_JIT
-def _trial_exact(h, Eh, psi, psiT, nu2, cc, P, gpat, mass, mud, on_struct, stuck, sig,
-                 eta0, etad0, w0, wd0, ser0, ser1, ag0, ag1, N0, N1, g0, g1,
-                 eta1, etad1, w1, wd1, lam1, s1, etadd, x0, x1, xd1, xdd, fq, fresh):
+def _trial_exact(h, Eh, PS, NC, P, gpat, MM, on_struct, stuck, sig, T0, S0, SER, NN, e,
+                 ag0, ag1, T1, S1, W, fresh):
     """Exact step of length h in a fixed contact state (E = propagator for h).
 
-    ``fresh``: g0 and x0 = Ψ η0 already hold the start state's values (the previous
-    sub-step's end, same configuration and contact state): they are not recomputed.
-    A leaf (the modal loads, the closed-form modal step and the products with Ψ written out,
-    each sum in dot-product order): numba then drops the reference counting of its ~35
-    array arguments, which a call to another compiled function keeps (an atomic increment
-    and decrement per array and call: most of this step's cost)."""
-    n = nu2.shape[0]
-    m = mass.shape[0]
-    npat = ser0.shape[0]
-    if not fresh:  # g0 = _loads(t0), x0 = Ψ η0
+    Packed arguments (rows): PS = Ψ, Ψᵀ; NC = ν², c (modal stiffness and damping); MM = mass,
+    mu_d of the sliders; T0, T1 = η, η̇, g (modal loads), x = Ψ η, xd = Ψ η̇ at the start
+    and the end; S0, S1 = w, ẇ, λ, s; SER, NN: load series and normal forces, row 0 at the
+    start, row ``e`` at the end; W: scratch η̈, Ψ η̈, structure load of the sliders.
+    ``fresh``: T0's g and x already hold the start state's values (the previous sub-step's
+    end, same configuration and contact state): they are not recomputed.
+
+    A leaf (no call to another compiled function) with few arguments: numba keeps an atomic
+    reference-count increment and decrement per array argument and call when the call is
+    inlined (as this one is), so the ~35 separate arrays this step once took cost more than
+    its arithmetic. Every sum is in dot-product order (bitwise as ``_mv``)."""
+    n = NC.shape[1]
+    m = MM.shape[1]
+    npat = SER.shape[1]
+    if not fresh:  # g0 = modal loads at the start (as g1 below), x0 = Ψ η0
         for i in range(n):
-            fq[i] = 0.0
+            W[2, i] = 0.0
         for j in range(m):
             if on_struct[j]:
-                f = -mass[j] * ag0 if stuck[j] else mud[j] * N0[j] * sig[j]
+                f = -MM[0, j] * ag0 if stuck[j] else MM[1, j] * NN[0, j] * sig[j]
                 if f != 0.0:
                     for i in range(n):
-                        fq[i] += P[j, i] * f
+                        W[2, i] += P[j, i] * f
         for k in range(n):
             acc = 0.0
             for c in range(npat):
-                acc += gpat[k, c] * ser0[c]
-            g0[k] = acc
-            x0[k] = 0.0
+                acc += gpat[k, c] * SER[0, c]
+            T0[2, k] = acc
         for i in range(n):
-            f = fq[i]
+            f = W[2, i]
             for k in range(n):
-                g0[k] += psi[i, k] * f
+                T0[2, k] += PS[0, i, k] * f
         for k in range(n):
-            e = eta0[k]
+            T0[3, k] = 0.0
+        for k in range(n):
+            ek = T0[0, k]
             for i in range(n):
-                x0[i] += psiT[k, i] * e
-    # g1 = _loads(t1)
+                T0[3, i] += PS[1, k, i] * ek
+    # g1 = modal loads at the end (structure load of the sliders in W[2])
     for i in range(n):
-        fq[i] = 0.0
+        W[2, i] = 0.0
     for j in range(m):
         if on_struct[j]:
-            f = -mass[j] * ag1 if stuck[j] else mud[j] * N1[j] * sig[j]
+            f = -MM[0, j] * ag1 if stuck[j] else MM[1, j] * NN[e, j] * sig[j]
             if f != 0.0:
                 for i in range(n):
-                    fq[i] += P[j, i] * f
+                    W[2, i] += P[j, i] * f
     for k in range(n):
         acc = 0.0
         for c in range(npat):
-            acc += gpat[k, c] * ser1[c]
-        g1[k] = acc
+            acc += gpat[k, c] * SER[e, c]
+        T1[2, k] = acc
     for i in range(n):
-        f = fq[i]
+        f = W[2, i]
         for k in range(n):
-            g1[k] += psi[i, k] * f
+            T1[2, k] += PS[0, i, k] * f
     # exact modal step, loads linear from g0 to g1 over h (particular part A + B τ,
     # homogeneous part through E), then the accelerations and Ψ (η1, η̇1, η̈1)
     for k in range(n):
-        s = (g1[k] - g0[k]) / h
-        B = s / nu2[k]
-        A = (g0[k] - cc[k] * B) / nu2[k]
-        y = eta0[k] - A
-        yd = etad0[k] - B
-        eta1[k] = A + B * h + Eh[k, 0] * y + Eh[k, 1] * yd
-        etad1[k] = B + Eh[k, 2] * y + Eh[k, 3] * yd
-        etadd[k] = g1[k] - cc[k] * etad1[k] - nu2[k] * eta1[k]
-        x1[k] = 0.0
-        xd1[k] = 0.0
-        xdd[k] = 0.0
+        s = (T1[2, k] - T0[2, k]) / h
+        B = s / NC[0, k]
+        A = (T0[2, k] - NC[1, k] * B) / NC[0, k]
+        y = T0[0, k] - A
+        yd = T0[1, k] - B
+        T1[0, k] = A + B * h + Eh[k, 0] * y + Eh[k, 1] * yd
+        T1[1, k] = B + Eh[k, 2] * y + Eh[k, 3] * yd
+        W[0, k] = T1[2, k] - NC[1, k] * T1[1, k] - NC[0, k] * T1[0, k]
+        T1[3, k] = 0.0
+        T1[4, k] = 0.0
+        W[1, k] = 0.0
     for k in range(n):
-        e = eta1[k]
-        ed = etad1[k]
-        edd = etadd[k]
+        e0 = T1[0, k]
+        e1 = T1[1, k]
+        e2 = W[0, k]
         for i in range(n):
-            x1[i] += psiT[k, i] * e
-            xd1[i] += psiT[k, i] * ed
-            xdd[i] += psiT[k, i] * edd
+            T1[3, i] += PS[1, k, i] * e0
+            T1[4, i] += PS[1, k, i] * e1
+            W[1, i] += PS[1, k, i] * e2
     for j in range(m):
         if stuck[j]:
             d0 = 0.0
@@ -150,35 +155,31 @@ def _trial_exact(h, Eh, psi, psiT, nu2, cc, P, gpat, mass, mud, on_struct, stuck
             if on_struct[j]:
                 for i in range(n):
                     p = P[j, i]
-                    d0 += p * x0[i]
-                    d1 += p * x1[i]
-                    v1 += p * xd1[i]
-                    a1_ += p * xdd[i]
-            w1[j] = w0[j] + (d1 - d0)
-            wd1[j] = v1
-            lam1[j] = mass[j] * (a1_ + ag1)
-            s1[j] = 0.0
+                    d0 += p * T0[3, i]
+                    d1 += p * T1[3, i]
+                    v1 += p * T1[4, i]
+                    a1_ += p * W[1, i]
+            S1[0, j] = S0[0, j] + (d1 - d0)
+            S1[1, j] = v1
+            S1[2, j] = MM[0, j] * (a1_ + ag1)
+            S1[3, j] = 0.0
         else:
-            lam0 = -mud[j] * N0[j] * sig[j]
-            lam1[j] = -mud[j] * N1[j] * sig[j]
-            a0 = -ag0 + lam0 / mass[j]
-            a1_ = -ag1 + lam1[j] / mass[j]
-            wd1[j] = wd0[j] + 0.5 * h * (a0 + a1_)
-            w1[j] = w0[j] + h * wd0[j] + h * h * (2.0 * a0 + a1_) / 6.0
+            lam0 = -MM[1, j] * NN[0, j] * sig[j]
+            S1[2, j] = -MM[1, j] * NN[e, j] * sig[j]
+            a0 = -ag0 + lam0 / MM[0, j]
+            a1_ = -ag1 + S1[2, j] / MM[0, j]
+            S1[1, j] = S0[1, j] + 0.5 * h * (a0 + a1_)
+            S1[0, j] = S0[0, j] + h * S0[1, j] + h * h * (2.0 * a0 + a1_) / 6.0
             v1 = 0.0
             if on_struct[j]:
                 for i in range(n):
-                    v1 += P[j, i] * xd1[i]
-            s1[j] = wd1[j] - v1
+                    v1 += P[j, i] * T1[4, i]
+            S1[3, j] = S1[1, j] - v1
     # every array's last use here, in the one exit block: numba's reference-count pruning
-    # then removes the increments and decrements of the arguments (see the docstring)
-    return (Eh.shape[0] + psi.shape[0] + psiT.shape[0] + nu2.shape[0] + cc.shape[0]
-            + P.shape[0] + gpat.shape[0] + mass.shape[0] + mud.shape[0] + on_struct.shape[0]
-            + stuck.shape[0] + sig.shape[0] + eta0.shape[0] + etad0.shape[0] + w0.shape[0]
-            + wd0.shape[0] + ser0.shape[0] + ser1.shape[0] + N0.shape[0] + N1.shape[0]
-            + g0.shape[0] + g1.shape[0] + eta1.shape[0] + etad1.shape[0] + w1.shape[0]
-            + wd1.shape[0] + lam1.shape[0] + s1.shape[0] + etadd.shape[0] + x0.shape[0]
-            + x1.shape[0] + xd1.shape[0] + xdd.shape[0] + fq.shape[0])
+    # then removes the increments and decrements of the arguments where it is not inlined
+    return (Eh.shape[0] + PS.shape[0] + NC.shape[0] + P.shape[0] + gpat.shape[0] + npat
+            + MM.shape[0] + on_struct.shape[0] + stuck.shape[0] + sig.shape[0] + T0.shape[0]
+            + S0.shape[0] + SER.shape[0] + NN.shape[0] + T1.shape[0] + S1.shape[0] + W.shape[0])
 
 
 @_JIT
