@@ -3,7 +3,7 @@
 thread, numba warm. Optional: ``--profile`` (cProfile of one run), ``--kernel`` (engine
 ``simulate`` alone vs the rest). Reports; never asserts on time. Run::
 
-    python benchmarks/paper_rack_time.py [-n 15] [--save-every none] [--profile]
+    python benchmarks/paper_rack_time.py [-n 15] [--save-every none] [--cold] [--profile]
 """
 
 from __future__ import annotations
@@ -28,6 +28,9 @@ def main() -> None:
     ap.add_argument("-n", type=int, default=15)
     ap.add_argument("--save-every", default="1")
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--cold", action="store_true",
+                    help="a freshly compiled model for every run (compile not timed): "
+                         "nothing cached per model (basis, operators)")
     ap.add_argument("--dump", default=None, help="save peaks to this .npz")
     args = ap.parse_args()
     save_every = None if args.save_every == "none" else int(args.save_every)
@@ -60,12 +63,15 @@ def main() -> None:
         return
     cpus, walls = [], []
     for _ in range(args.n):
+        if args.cold:
+            model = compile_rack(spec)
         c0, t0 = time.process_time(), time.perf_counter()
         res = run()
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     h = res.history
-    print(f"paper rack run_rack, save_every={save_every}: best CPU {1e3 * min(cpus):.2f} ms, "
+    print(f"paper rack run_rack{' (cold model)' if args.cold else ''}, "
+          f"save_every={save_every}: best CPU {1e3 * min(cpus):.2f} ms, "
           f"best wall {1e3 * min(walls):.2f} ms, median CPU {1e3 * np.median(cpus):.2f} ms "
           f"(n={args.n}); events {len(h.events)}, basis {h.basis}")
     if args.dump:
