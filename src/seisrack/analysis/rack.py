@@ -227,8 +227,8 @@ def _model_cache(model: FrameModel) -> dict:
 
 
 def _locked(obj):  # noqa: ANN001, ANN202
-    """``obj`` with its arrays (fields of a dataclass, one level of nesting, dict values)
-    made read-only, since it is shared by every run of a model (returned as is)."""
+    """``obj`` with its arrays (through dataclass fields and dict values, recursively) made
+    read-only, since it is shared by every run of a model (returned as is)."""
     import dataclasses
 
     def lock(x) -> None:  # noqa: ANN001
