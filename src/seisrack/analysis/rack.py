@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -21,6 +22,7 @@ from seisrack.analysis.peaks import (
     PeakTracker,
     RackOperators,
     connection_moment,
+    level_sum,
     rack_operators,
 )
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
@@ -154,13 +156,31 @@ def run_rack(
     common = dict(dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
                   vertical_influence=None if av is None else model.r_y, g=model.g,
                   backend=backend, throw=throw, method=method)
-    # the basis is built once and shared with the companion run
-    bas = basis if isinstance(basis, Basis) else rack_basis(model, sliders, basis, av, hinges)
-    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
-    pallet_level = np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int)
+    # the basis is built once and shared with the companion run (and with the next runs of
+    # the same model: see _model_cache)
+    cache = _model_cache(model)
+    if isinstance(basis, Basis):
+        bas, ops_key = basis, None
+    else:
+        if basis not in ("auto", "full", "reduced"):
+            raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+        key = ("basis", basis, av is not None)
+        bas = cache.get(key)
+        if bas is None:
+            bas = cache[key] = _locked(rack_basis(model, sliders, basis, av, hinges))
+        ops_key = ("operators", *key[1:])
+    pallet_level = cache.get("pallet_level")
+    if pallet_level is None:
+        level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+        pallet_level = cache["pallet_level"] = _locked(
+            np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int))
     P = bas.phi[model.pallet_dof, :]  # (m, r) support of each pallet
     if operators is None:
-        ops = rack_operators(model, bas.phi)
+        ops = None if ops_key is None else cache.get(ops_key)
+        if ops is None:
+            ops = _locked(rack_operators(model, bas.phi))
+            if ops_key is not None:
+                cache[ops_key] = ops
     elif operators.level.shape[0] != bas.phi.shape[1]:
         raise InputError("operators", f"operators for a basis of {operators.level.shape[0]}",
                          f"rack_operators(model, basis.phi) of this basis ({bas.size} vectors)")
@@ -211,6 +231,40 @@ def run_rack(
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
                    beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx],
                    hinges=hinge_response(model, hist, hpk))
+
+
+#: per compiled model (weakly held: dropped with the model), what every run of it rebuilds
+#: otherwise: the basis, the recovery and design operators in it, the pallets' levels. A
+#: FrameModel is immutable (frozen, its arrays locked), so these cannot go stale.
+_MODEL_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _model_cache(model: FrameModel) -> dict:
+    try:
+        return _MODEL_CACHE.setdefault(model, {})
+    except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
+        return {}
+
+
+def _locked(obj):  # noqa: ANN001, ANN202
+    """``obj`` with its arrays (through dataclass fields and dict values, recursively) made
+    read-only, since it is shared by every run of a model (returned as is)."""
+    import dataclasses
+
+    def lock(x) -> None:  # noqa: ANN001
+        if isinstance(x, np.ndarray):
+            x.flags.writeable = False
+        elif isinstance(x, dict):
+            for v in x.values():
+                lock(v)
+        elif dataclasses.is_dataclass(x) and not isinstance(x, type):
+            for f in dataclasses.fields(x):
+                v = getattr(x, f.name)
+                if isinstance(v, np.ndarray | dict) or dataclasses.is_dataclass(v):
+                    lock(v)
+
+    lock(obj)
+    return obj
 
 
 def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
@@ -302,8 +356,7 @@ def _response(
     else:  # exact propagators leave no period-2h residue; decimated samples are not smoothed
         acc = acc_raw
     n_level = len(model.level_dofs)
-    force = np.zeros((idx.shape[0], n_level))
-    np.add.at(force.T, pallet_level, hist.friction.T)
+    force = level_sum(hist.friction, pallet_level, n_level)
     # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
     # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
     base_shear = hist.q @ ops.shear + ops.a1 * (hist.qd @ ops.shear)

@@ -1,4 +1,5 @@
-"""Closed-form modal propagation and its exact work integrals (exact kernel, part 1 of 3).
+"""Closed-form modal propagation (the trial step) and its exact work integrals (exact kernel,
+part 1 of 3).
 
 Source shared by the numba and pure-Python backends (see :mod:`seisrack.dynamics.kernels`):
 executed after ``_events.py`` and ``_kernel.py`` in one namespace by ``_kernel_numba.py``.
@@ -63,35 +64,122 @@ def _mode_matrices(nu2, cc, h, E):
 
 
 @_JIT
-def _propagate(nu2, cc, E, eta0, etad0, g0, g1, h, eta1, etad1):
-    """Exact modal step: loads g linear from g0 to g1 over h; E from ``_mode_matrices(h)``."""
-    for k in range(nu2.shape[0]):
-        s = (g1[k] - g0[k]) / h
-        B = s / nu2[k]
-        A = (g0[k] - cc[k] * B) / nu2[k]
-        y = eta0[k] - A
-        yd = etad0[k] - B
-        eta1[k] = A + B * h + E[k, 0] * y + E[k, 1] * yd
-        etad1[k] = B + E[k, 2] * y + E[k, 3] * yd
+def _trial_exact(h, Eh, PS, NC, P, gpat, MM, on_struct, stuck, sig, T0, S0, SER, NN, e,
+                 ag0, ag1, T1, S1, W, fresh):
+    """Exact step of length h in a fixed contact state (E = propagator for h).
 
+    Packed arguments (rows): PS = Ψ, Ψᵀ; NC = ν², c (modal stiffness and damping); MM = mass,
+    mu_d of the sliders; T0, T1 = η, η̇, g (modal loads), x = Ψ η, xd = Ψ η̇ at the start
+    and the end; S0, S1 = w, ẇ, λ, s; SER, NN: load series and normal forces, row 0 at the
+    start, row ``e`` at the end; W: scratch η̈, Ψ η̈, structure load of the sliders.
+    ``fresh``: T0's g and x already hold the start state's values (the previous sub-step's
+    end, same configuration and contact state): they are not recomputed.
 
-@_JIT
-def _sliding_modal_load(psi, P, mud, sig, Na, Nb, a, b, on_struct, stuck, fq, out):
-    """out = Ψᵀ Σ_j P_jᵀ c_j over the sliders sliding on the structure, with
-    c_j = -mu_d,j σ_j (a Na_j + b Nb_j) (the friction force, or its slope in time)."""
-    r = fq.shape[0]
-    for i in range(r):
-        fq[i] = 0.0
-    for j in range(mud.shape[0]):
-        if on_struct[j] and not stuck[j]:
-            c = -mud[j] * sig[j] * (a * Na[j] + b * Nb[j])
-            for i in range(r):
-                fq[i] += P[j, i] * c
-    for k in range(out.shape[0]):
+    A leaf (no call to another compiled function) with few arguments: numba keeps an atomic
+    reference-count increment and decrement per array argument and call when the call is
+    inlined (as this one is), so the ~35 separate arrays this step once took cost more than
+    its arithmetic. Every sum is in dot-product order (bitwise as ``_mv``)."""
+    n = NC.shape[1]
+    m = MM.shape[1]
+    npat = SER.shape[1]
+    if not fresh:  # g0 = modal loads at the start (as g1 below), x0 = Ψ η0
+        for i in range(n):
+            W[2, i] = 0.0
+        for j in range(m):
+            if on_struct[j]:
+                f = -MM[0, j] * ag0 if stuck[j] else MM[1, j] * NN[0, j] * sig[j]
+                if f != 0.0:
+                    for i in range(n):
+                        W[2, i] += P[j, i] * f
+        for k in range(n):
+            acc = 0.0
+            for c in range(npat):
+                acc += gpat[k, c] * SER[0, c]
+            T0[2, k] = acc
+        for i in range(n):
+            f = W[2, i]
+            for k in range(n):
+                T0[2, k] += PS[0, i, k] * f
+        for k in range(n):
+            T0[3, k] = 0.0
+        for k in range(n):
+            ek = T0[0, k]
+            for i in range(n):
+                T0[3, i] += PS[1, k, i] * ek
+    # g1 = modal loads at the end (structure load of the sliders in W[2])
+    for i in range(n):
+        W[2, i] = 0.0
+    for j in range(m):
+        if on_struct[j]:
+            f = -MM[0, j] * ag1 if stuck[j] else MM[1, j] * NN[e, j] * sig[j]
+            if f != 0.0:
+                for i in range(n):
+                    W[2, i] += P[j, i] * f
+    for k in range(n):
         acc = 0.0
-        for i in range(r):
-            acc += psi[i, k] * fq[i]
-        out[k] = acc
+        for c in range(npat):
+            acc += gpat[k, c] * SER[e, c]
+        T1[2, k] = acc
+    for i in range(n):
+        f = W[2, i]
+        for k in range(n):
+            T1[2, k] += PS[0, i, k] * f
+    # exact modal step, loads linear from g0 to g1 over h (particular part A + B τ,
+    # homogeneous part through E), then the accelerations and Ψ (η1, η̇1, η̈1)
+    for k in range(n):
+        s = (T1[2, k] - T0[2, k]) / h
+        B = s / NC[0, k]
+        A = (T0[2, k] - NC[1, k] * B) / NC[0, k]
+        y = T0[0, k] - A
+        yd = T0[1, k] - B
+        T1[0, k] = A + B * h + Eh[k, 0] * y + Eh[k, 1] * yd
+        T1[1, k] = B + Eh[k, 2] * y + Eh[k, 3] * yd
+        W[0, k] = T1[2, k] - NC[1, k] * T1[1, k] - NC[0, k] * T1[0, k]
+        T1[3, k] = 0.0
+        T1[4, k] = 0.0
+        W[1, k] = 0.0
+    for k in range(n):
+        e0 = T1[0, k]
+        e1 = T1[1, k]
+        e2 = W[0, k]
+        for i in range(n):
+            T1[3, i] += PS[1, k, i] * e0
+            T1[4, i] += PS[1, k, i] * e1
+            W[1, i] += PS[1, k, i] * e2
+    for j in range(m):
+        if stuck[j]:
+            d0 = 0.0
+            d1 = 0.0
+            v1 = 0.0
+            a1_ = 0.0
+            if on_struct[j]:
+                for i in range(n):
+                    p = P[j, i]
+                    d0 += p * T0[3, i]
+                    d1 += p * T1[3, i]
+                    v1 += p * T1[4, i]
+                    a1_ += p * W[1, i]
+            S1[0, j] = S0[0, j] + (d1 - d0)
+            S1[1, j] = v1
+            S1[2, j] = MM[0, j] * (a1_ + ag1)
+            S1[3, j] = 0.0
+        else:
+            lam0 = -MM[1, j] * NN[0, j] * sig[j]
+            S1[2, j] = -MM[1, j] * NN[e, j] * sig[j]
+            a0 = -ag0 + lam0 / MM[0, j]
+            a1_ = -ag1 + S1[2, j] / MM[0, j]
+            S1[1, j] = S0[1, j] + 0.5 * h * (a0 + a1_)
+            S1[0, j] = S0[0, j] + h * S0[1, j] + h * h * (2.0 * a0 + a1_) / 6.0
+            v1 = 0.0
+            if on_struct[j]:
+                for i in range(n):
+                    v1 += P[j, i] * T1[4, i]
+            S1[3, j] = S1[1, j] - v1
+    # every array's last use here, in the one exit block: numba's reference-count pruning
+    # then removes the increments and decrements of the arguments where it is not inlined
+    return (Eh.shape[0] + PS.shape[0] + NC.shape[0] + P.shape[0] + gpat.shape[0] + npat
+            + MM.shape[0] + on_struct.shape[0] + stuck.shape[0] + sig.shape[0] + T0.shape[0]
+            + S0.shape[0] + SER.shape[0] + NN.shape[0] + T1.shape[0] + S1.shape[0] + W.shape[0])
 
 
 @_JIT
@@ -113,8 +201,36 @@ def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_s
     e_d = 0.0
     e_f = 0.0
     # sliding forces on the structure, λ_j(τ) = l0_j + ls_j τ, as modal loads f0 + fs τ
-    _sliding_modal_load(psi, P, mud, sig, N0, N0, 1.0, 0.0, on_struct, stuck, fq, f0)
-    _sliding_modal_load(psi, P, mud, sig, N1, N0, 1.0 / h, -1.0 / h, on_struct, stuck, fq, fs)
+    # (written out so that this function stays a leaf, see ``_trial_exact``: a call to
+    # another compiled function keeps numba's reference counting of every array argument;
+    # nothing to add when every slider on the structure sticks, the usual case)
+    any_sliding = False
+    for j in range(m):
+        if on_struct[j] and not stuck[j]:
+            any_sliding = True
+    for k in range(n):
+        f0[k] = 0.0
+        fs[k] = 0.0
+    if any_sliding:
+        for side in range(2):
+            a = 1.0 if side == 0 else 1.0 / h
+            b = 0.0 if side == 0 else -1.0 / h
+            for i in range(n):
+                fq[i] = 0.0
+            for j in range(m):
+                if on_struct[j] and not stuck[j]:
+                    Na = N0[j] if side == 0 else N1[j]
+                    c = -mud[j] * sig[j] * (a * Na + b * N0[j])
+                    for i in range(n):
+                        fq[i] += P[j, i] * c
+            for i in range(n):
+                f = fq[i]
+                if side == 0:
+                    for k in range(n):
+                        f0[k] += psi[i, k] * f
+                else:
+                    for k in range(n):
+                        fs[k] += psi[i, k] * f
     for k in range(n):
         c = cc[k]
         w = nu2[k]
@@ -143,9 +259,10 @@ def _energy_substep(h, Eh, psi, nu2, cc, P, eta0, etad0, g0, g1, mass, mud, on_s
             e_d += (c * B * B * h + 2.0 * c * B * (y1 - y0)
                     + cw11 * y0 * y0 + 2.0 * cw12 * y0 * yd0 + cw22 * yd0 * yd0)
         # sliding forces on the structure: their power leaves the input, enters friction
-        work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
-        e_in += work
-        e_f += work
+        if any_sliding:
+            work = f0[k] * d_eta + fs[k] * mom  # Σ_j ∫ λ_j v_support dτ
+            e_in += work
+            e_f += work
     for j in range(m):
         if stuck[j]:
             continue  # stuck on the structure: inside g; stuck on the ground: no motion

@@ -17,7 +17,11 @@ from pathlib import Path
 
 import numba
 
-_JIT = numba.njit(cache=True)
+#: "numpy" error model: a float division by zero gives inf / nan (caught as a non-finite
+#: state) instead of raising; without the raise paths numba can drop the reference counting
+#: of a leaf function's array arguments (an atomic increment and decrement each per call)
+_OPTIONS = {"cache": True, "error_model": "numpy"}
+_JIT = numba.njit(**_OPTIONS)
 _NAMES = ("_hysteresis.py", "_events.py", "_linalg.py", "_contact.py", "_kernel_hinge.py",
           "_kernel.py", "_exact_modes.py", "_exact_config.py", "_kernel_exact.py")
 
@@ -25,7 +29,8 @@ _NAMES = ("_hysteresis.py", "_events.py", "_linalg.py", "_contact.py", "_kernel_
 def _combined_source() -> Path:
     here = Path(__file__).parent
     parts = [f"# ---- {n}\n" + here.joinpath(n).read_text(encoding="utf-8") for n in _NAMES]
-    text = "\n".join(parts)
+    # the options are part of the hashed text: numba's cache does not key on them
+    text = f"# numba.njit options: {_OPTIONS}\n" + "\n".join(parts)
     digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
     for folder in (here / "__pycache__", Path(tempfile.gettempdir()) / "seisrack-kernels"):
         path = folder / f"_kernels_{digest}.py"

@@ -46,6 +46,15 @@ class Kept:
         if sel.size == 0:
             return
         loc = sel - start
+        if loc[-1] - loc[0] == loc.size - 1:  # every step (save_every=1): a slice, no gather
+            if start == 0 and stop == n_steps and loc.size == outs[0].shape[0]:
+                # the whole run in one chunk, every sample kept: adopt the chunk's buffers
+                # (not reused: this is the last chunk) instead of copying them
+                (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck,
+                 self.energy, self.hm) = outs
+                self.N, self.idx, self.count = N, sel, sel.size
+                return
+            loc = slice(int(loc[0]), int(loc[-1]) + 1)
         a, b = self.count, self.count + sel.size
         for dst, src in zip(
             (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck, self.energy,
