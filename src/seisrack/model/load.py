@@ -245,12 +245,11 @@ def _footprint(t: Table, geom: Geometry) -> dict[str, float]:
     depth, over = out.get("depth"), out.get("overhang")
     if depth is not None and over is not None and over >= depth:
         raise t.error("overhang", over, f"an overhang >= 0 and < the pallet depth {depth:g} m")
-    if depth is not None and geom.depth is not None:
-        allowed = geom.depth + 2.0 * (over or 0.0)
+    if depth is not None and over is not None and geom.depth is not None:
+        allowed = geom.depth + 2.0 * over
         if depth > allowed + _GEOM_TOL:
             raise t.error("depth", depth, f"a pallet depth <= the frame depth + 2 x overhang = "
-                                          f"{geom.depth:g} + 2 x {over or 0.0:g} = "
-                                          f"{allowed:g} m")
+                                          f"{geom.depth:g} + 2 x {over:g} = {allowed:g} m")
     return out
 
 
