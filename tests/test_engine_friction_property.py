@@ -102,8 +102,14 @@ def test_coulomb_law_everywhere(problem):
     assert np.all(F[moving] * sv[moving] <= 0.0)
     # stuck means zero relative velocity: no creep
     assert np.all(np.abs(sv[res.stuck]) <= 1e-9 * vscale)
-    # sliding displacement does not change while stuck (between consecutive stuck samples)
+    # sliding displacement does not change while stuck (between consecutive stuck samples
+    # with no event of that slider in between: a slip and a re-stick may both fall inside one
+    # step, e.g. t = 1.3406 and 1.3440 s in one drawn case)
     both = res.stuck[1:] & res.stuck[:-1]
+    for ev in res.events:
+        k = int(np.searchsorted(res.t, ev.time_s, side="left"))  # event in (t[k-1], t[k]]
+        if 1 <= k < res.t.size:
+            both[k - 1, ev.slider] = False
     ds = np.diff(res.sliding, axis=0)
     sscale = max(float(np.max(np.abs(res.slider_u))), float(np.max(np.abs(res.u))), 1e-12)
     assert np.all(np.abs(ds[both]) <= 1e-9 * sscale)
