@@ -37,6 +37,8 @@ DEFAULT_BLOCKS = 8
 DEFAULT_TOL = 3e-2
 #: relative norm below which a Krylov direction counts as linearly dependent
 _DEPENDENT = 1e-7
+#: up to this many DOFs the Ritz vectors are built with dense algebra (Cholesky of K)
+_DENSE_MAX_DOF = 300
 #: Krylov blocks after the first are added only while the basis stays within this size (small
 #: structures get more blocks for free; large ones keep the cost per contact event low)
 DEFAULT_TARGET_SIZE = 40
@@ -126,8 +128,15 @@ def reduced_basis(
     add = sp.csc_matrix((np.asarray(slider_mass, float)[on], (dof[on], dof[on])), shape=(n, n))
     M0 = (Ms + add).tocsc()
     try:
-        lu = spla.splu(Ks)
-    except RuntimeError as exc:
+        if n <= _DENSE_MAX_DOF:
+            # small structures: dense Cholesky and products (scipy.sparse's per-call overhead
+            # was most of the basis time on the paper rack)
+            Ks, Ms, M0 = Ks.toarray(), Ms.toarray(), M0.toarray()
+            cho = scipy.linalg.cho_factor(Ks)
+            solve = lambda B: scipy.linalg.cho_solve(cho, B)  # noqa: E731
+        else:
+            solve = spla.splu(Ks).solve
+    except (RuntimeError, np.linalg.LinAlgError) as exc:
         raise InputError(
             "K", "singular", "a stable structure (positive-definite stiffness)"
         ) from exc
@@ -136,7 +145,7 @@ def reduced_basis(
     F = np.zeros((n, loads.shape[1] + udofs.size))
     F[:, : loads.shape[1]] = loads
     F[udofs, loads.shape[1] + np.arange(udofs.size)] = 1.0
-    block = lu.solve(np.asfortranarray(F))
+    block = solve(np.asfortranarray(F))
     V = np.zeros((n, 0))
     n_blocks = 0
     while n_blocks < blocks and V.shape[1] < max_size:
@@ -149,7 +158,7 @@ def reduced_basis(
             break
         V = np.column_stack([V, block])
         n_blocks += 1
-        block = lu.solve(np.asfortranarray(M0 @ block))
+        block = solve(np.asfortranarray(M0 @ block))
     Kr = V.T @ (Ks @ V)
     Mr = V.T @ (Ms @ V)
     try:
