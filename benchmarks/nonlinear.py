@@ -311,8 +311,9 @@ def report(env, load0, load1, rows, agree, loops) -> str:
     w("")
     w("- The OpenSees ratio is taken on the peer model (pallets rigid, P-Δ off), the model "
       "both programs run; the example itself has P-Δ on and sliding-capable pallets "
-      "(mu 0.6), which the export cannot carry over (Linear transformation, no gravity; "
-      "ElasticPP friction with mu_s = mu_d).")
+      "(mu 0.6), which the export cannot carry over (Linear transformation: no P-Δ; "
+      "ElasticPP friction with mu_s = mu_d). Both programs apply gravity first, so the "
+      "connections start from their gravity moments.")
     w("- seisrack's default basis on this 61-DOF rack is whatever the engine's `basis=\"auto\"` "
       "chooses in the commit above (full modes, or a Ritz basis with hinge vectors above "
       "`AUTO_FULL_MAX_DOF`); the DOFs column and the two peer rows show the cost of each.")
