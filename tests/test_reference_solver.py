@@ -125,10 +125,12 @@ def test_friction_bound_never_exceeded_random_structures(n, m, seed, amp, freq):
     _check_physics(ref, mu_s, mu_d, mass, dof)
 
 
-@pytest.mark.xfail(strict=True, reason="known bug of the reference solver (found 2026-11-23 "
-                   "by a random example): with two sliders on one DOF it misses a zero "
-                   "crossing of slider 1's relative velocity at t = 0.4475 s after a reversal, "
-                   "so it slides on with the friction pushing it; not investigated yet")
+@pytest.mark.xfail(strict=True, reason="known limitation of the reference solver (found "
+                   "2026-11-23 by a random example): slider 1's relative velocity grazes zero "
+                   "(down at t = 0.4475 s, back up before 0.4535 s, dipping to -1.4e-3 m/s); "
+                   "both crossings fall inside one DOP853 step (max_step 10 ms), so solve_ivp "
+                   "sees no sign change and the slider slides on with the friction pushing it "
+                   "for about 6 ms")
 def test_friction_opposes_sliding_two_sliders_on_one_dof_known_bug():
     test_friction_bound_never_exceeded_random_structures.hypothesis.inner_test(
         n=1, m=2, seed=16364, amp=3.90625, freq=2.0234375)
