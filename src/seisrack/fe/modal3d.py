@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.fe.eigen import Method, ModalResult, modal_from_matrices
 from seisrack.fe.mesh import FloatArray
-from seisrack.fe.modal import Method, ModalResult, modal_from_matrices
 
 DIRECTIONS = ("down-aisle", "cross-aisle", "torsional", "other")
 #: a mode whose three participation ratios are all below this is "other" (vertical or local)

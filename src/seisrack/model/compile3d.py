@@ -25,29 +25,12 @@ from seisrack.fe.assembly import symmetric_csr
 from seisrack.fe.assembly3d import assemble_sparse_3d
 from seisrack.fe.modal import modal_from_matrices
 from seisrack.fe.stability import is_positive_definite
+from seisrack.model.dimension import RUN_3D_MESSAGE, require_2d  # noqa: F401  (re-exported)
 from seisrack.model.frame_model3d import FrameModel3D
 from seisrack.model.rack_mesh3d import RackMesh3D, build_rack_mesh_3d
 from seisrack.model.spec import Connections, RackSpec
 
 log = logging.getLogger(__name__)
-
-RUN_3D_MESSAGE = ("3D time histories are not available yet; use seisrack modal (a 3D rack "
-                  "supports modal analysis only for now)")
-
-
-def require_2d(spec_or_model: object, field: str = "geometry.depth",
-               depth: float | None = None) -> None:
-    """Raise InputError for a 3D rack (spec, compiled model or, with ``depth``, its mesh)
-    where only 2D is supported, e.g. at the top of a time history (``seisrack run``)."""
-    is_3d = depth is not None or getattr(spec_or_model, "is_3d", False)
-    if is_3d:
-        if depth is None:
-            depth = getattr(spec_or_model, "depth", None)
-        if depth is None:
-            depth = spec_or_model.geometry.depth  # type: ignore[attr-defined]
-        raise InputError(field, depth, "a 2D rack (no [geometry] depth) for time histories, "
-                         "reports and exports", hint=RUN_3D_MESSAGE)
-
 
 def compile_rack_3d(spec: RackSpec) -> FrameModel3D:
     """Build the 3D model of ``spec``; InputError for missing section properties, a mechanism

@@ -91,9 +91,9 @@ class FrameModel3D:
     def __getattr__(self, name: str) -> Any:
         # Only reached when normal lookup fails: a 2D-only attribute (pallet_dof, level_dofs,
         # hinge_dofs, ...) asked by the 2D time history, report or export stops with a clear
-        # InputError instead of a traceback (see seisrack.model.compile3d.require_2d).
+        # InputError instead of a traceback (see seisrack.model.dimension.require_2d).
         if name in _2D_ONLY:
-            from seisrack.model.compile3d import require_2d
+            from seisrack.model.dimension import require_2d
 
             require_2d(self)
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")

@@ -71,7 +71,7 @@ class Mesh3D:
         # 2D-only mesh attributes (I, direction_cosines, ...): a clear InputError for 2D code
         # handed a 3D rack (e.g. the OpenSees export), not a traceback.
         if name in ("I", "direction_cosines", "ground_spring_k", "n_el"):
-            from seisrack.model.compile3d import require_2d
+            from seisrack.model.dimension import require_2d
 
             require_2d(self, depth=float(np.ptp(self.nodes[:, 2])))
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
