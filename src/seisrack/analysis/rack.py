@@ -33,6 +33,7 @@ from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack A
 )
 from seisrack.dynamics import Sliders, TimeHistory, simulate
 from seisrack.dynamics.basis import Basis
+from seisrack.dynamics.engine import single_blas_thread
 from seisrack.dynamics.hinges import Hinges
 from seisrack.errors import InputError, SolverError
 from seisrack.model.frame_model import FrameModel
@@ -71,6 +72,7 @@ def _resample(a: np.ndarray, k: int) -> np.ndarray:
     return np.interp(x, np.arange(n), a)
 
 
+@single_blas_thread
 def run_rack(
     model: FrameModel,
     record: Record,

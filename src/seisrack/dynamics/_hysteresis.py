@@ -154,21 +154,22 @@ def _hyst_init(law, par, st):
 # ---------------------------------------------------------------- bilinear (Steel01, b >= 0)
 
 @_JIT
-def _hyst_bilinear(par, st_c, theta, st_t):
+def _hyst_bilinear(par, st_c, i, theta):
     """Kinematic hardening between the bounding lines M = b·k·θ ± (1 − b)·My: the elastic
-    predictor M_c + k·Δθ is clipped to them (Steel01 with a1 = a3 = 0)."""
-    k = par[0]
-    fy = par[1]
-    b = par[2]
-    dth = theta - st_c[HYST_S_THETA]
+    predictor M_c + k·Δθ is clipped to them (Steel01 with a1 = a3 = 0). Row ``i`` of the 2D
+    parameter and committed-state arrays (indexed in place: no array view per call)."""
+    k = par[i, 0]
+    fy = par[i, 1]
+    b = par[i, 2]
+    dth = theta - st_c[i, HYST_S_THETA]
     if abs(dth) <= _HYST_DBL_EPS:
-        m = st_c[HYST_S_M]
-        kt = st_c[HYST_S_KT]
+        m = st_c[i, HYST_S_M]
+        kt = st_c[i, HYST_S_KT]
     else:
         kh = b * k
         cap = fy * (1.0 - b)
         line = kh * theta
-        m = st_c[HYST_S_M] + k * dth
+        m = st_c[i, HYST_S_M] + k * dth
         kt = k
         upper = line + cap
         if upper < m:
@@ -498,20 +499,29 @@ def _hyst_pinching(par, st_c, u, st_t):
 def _hyst_trial(law, par, st_c, theta, st_t):
     """Trial state at total rotation ``theta`` from the committed row ``st_c`` (unchanged):
     writes ``st_t`` and returns (moment, consistent tangent dM/dθ)."""
-    for i in range(st_t.shape[0]):
-        st_t[i] = st_c[i]
+    return _hyst_trial_at(law, par.reshape((1, par.shape[0])), st_c.reshape((1, st_c.shape[0])),
+                          0, theta, st_t.reshape((1, st_t.shape[0])))
+
+
+@_JIT
+def _hyst_trial_at(law, par, st_c, i, theta, st_t):
+    """:func:`_hyst_trial` on row ``i`` of 2D parameter / state arrays (n_h, ·): the kernels'
+    form, which indexes in place instead of creating three array views per call (each view
+    costs numba an atomic reference count, per hinge and Newton iteration)."""
+    for c in range(st_t.shape[1]):
+        st_t[i, c] = st_c[i, c]
     if law == HYST_ELASTIC:
-        kt = par[0]
+        kt = par[i, 0]
         m = kt * theta
     elif law == HYST_PINCHING:
-        m, kt = _hyst_pinching(par, st_c, theta, st_t)
+        m, kt = _hyst_pinching(par[i], st_c[i], theta, st_t[i])
     else:
-        m, kt = _hyst_bilinear(par, st_c, theta, st_t)
-    st_t[HYST_S_WORK] = st_c[HYST_S_WORK] + 0.5 * (m + st_c[HYST_S_M]) * (
-        theta - st_c[HYST_S_THETA])
-    st_t[HYST_S_THETA] = theta
-    st_t[HYST_S_M] = m
-    st_t[HYST_S_KT] = kt
+        m, kt = _hyst_bilinear(par, st_c, i, theta)
+    st_t[i, HYST_S_WORK] = st_c[i, HYST_S_WORK] + 0.5 * (m + st_c[i, HYST_S_M]) * (
+        theta - st_c[i, HYST_S_THETA])
+    st_t[i, HYST_S_THETA] = theta
+    st_t[i, HYST_S_M] = m
+    st_t[i, HYST_S_KT] = kt
     return m, kt
 
 

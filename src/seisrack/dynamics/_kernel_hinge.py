@@ -29,11 +29,11 @@ Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``
 import numpy as np
 
 try:  # names injected by the loader when executed after ``_hysteresis.py`` and ``_linalg.py``
-    _hyst_trial  # type: ignore[used-before-def]  # noqa: B018
+    _hyst_trial_at  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._contact import _newmark_end
     from seisrack.dynamics._events import _JIT
-    from seisrack.dynamics._hysteresis import HYST_S_M, HYST_S_THETA, _hyst_trial
+    from seisrack.dynamics._hysteresis import HYST_S_M, HYST_S_THETA, _hyst_trial_at
     from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve_into
 
 STATUS_NEWTON = 4
@@ -65,7 +65,7 @@ def _hinge_state(Q, hth0, hk, hlaw, hpar, hst_c, q, hst_t, hM, hz):
         th = hth0[i]
         for k in range(Q.shape[1]):
             th += Q[i, k] * q[k]
-        Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th, hst_t[i])
+        Mi, _kt = _hyst_trial_at(hlaw[i], hpar, hst_c, i, th, hst_t)
         hM[i] = Mi
         hz[i] = Mi - hk[i] * th
 
@@ -142,7 +142,7 @@ def _nl_trial(
         same = it > 0 and not smooth
         for i in range(nh):
             th = x[m + i]
-            Mi, kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th, hst_t[i])
+            Mi, kt = _hyst_trial_at(hlaw[i], hpar, hst_c, i, th, hst_t)
             hM[i] = Mi
             hz[i] = Mi - hk[i] * th
             zp[i] = kt - hk[i]
@@ -231,7 +231,7 @@ def _hinge_commit(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
             th1 = hth0[i]
             for k in range(Q.shape[1]):
                 th1 += Q[i, k] * q1[k]
-            Mi, _kt = _hyst_trial(hlaw[i], hpar[i], hst_c[i], th1, hst_t[i])
+            Mi, _kt = _hyst_trial_at(hlaw[i], hpar, hst_c, i, th1, hst_t)
         hM[i] = Mi
         hz[i] = Mi - hk[i] * th1
         work += 0.5 * (z0 + hz[i]) * (th1 - th0)
