@@ -2,7 +2,7 @@
 
 numba caches each compiled specialisation on disk; a second process that meets argument types
 the warm-up did not build (read-only arrays from a compiled model, a vertical record, Newmark,
-the rigid companion) would compile for 30-70 s. This test runs those paths in a fresh process
+the rigid companion, nonlinear connections) would compile for 30-70 s. This test runs those paths in a fresh process
 and reads numba's own dispatcher statistics: every kernel call must be a cache hit and none a
 cache miss (a miss is a compilation). Reference: numba's ``Dispatcher.stats`` (cache_hits,
 cache_misses) — https://numba.readthedocs.io, "Notes on caching".
@@ -38,6 +38,9 @@ run_rack(model, rec, vertical=dataclasses.replace(rec, accel=0.3 * rec.accel),
          save_every=None)
 big = compile_rack(with_friction(load_rack("examples/three_level_rack.toml"), 0.2))
 run_rack(big, rec)
+nonlinear = compile_rack(with_friction(load_rack("examples/paper_rack_nonlinear.toml"), 0.3))
+run_rack(nonlinear, rec)
+main(["run", "examples/paper_rack_nonlinear.toml", "--builtin", "elcentro_1940_ns", "--json"])
 main(["run", "examples/paper_rack.toml", "--builtin", "elcentro_1940_ns", "--mu", "0.3",
       "--json"])
 out = {}

@@ -1,7 +1,7 @@
-"""numba-compiled build of ``_hysteresis.py``, ``_events.py``, ``_linalg.py``, ``_contact.py``,
-``_kernel_hinge.py``, ``_kernel.py``, ``_exact_modes.py``, ``_exact_config.py`` and
-``_kernel_exact.py`` (the same sources, executed in this order with ``_JIT = njit`` in one
-namespace).
+"""numba-compiled build of ``_hyst_base.py``, ``_hyst_pinching.py``, ``_hysteresis.py``,
+``_events.py``, ``_linalg.py``, ``_contact.py``, ``_kernel_hinge.py``, ``_kernel.py``,
+``_exact_modes.py``, ``_exact_config.py`` and ``_kernel_exact.py`` (the same sources,
+executed in this order with ``_JIT = njit`` in one namespace).
 
 numba's on-disk cache keys each function on the timestamp of *its own* source file, while a
 compiled caller embeds the code of the callees it uses from the other files: after an edit of
@@ -22,8 +22,9 @@ import numba
 #: of a leaf function's array arguments (an atomic increment and decrement each per call)
 _OPTIONS = {"cache": True, "error_model": "numpy"}
 _JIT = numba.njit(**_OPTIONS)
-_NAMES = ("_hysteresis.py", "_events.py", "_linalg.py", "_contact.py", "_kernel_hinge.py",
-          "_kernel.py", "_exact_modes.py", "_exact_config.py", "_kernel_exact.py")
+_NAMES = ("_hyst_base.py", "_hyst_pinching.py", "_hysteresis.py", "_events.py", "_linalg.py",
+          "_contact.py", "_kernel_hinge.py", "_kernel.py", "_exact_modes.py", "_exact_config.py",
+          "_kernel_exact.py")
 
 
 def _combined_source() -> Path:

@@ -250,8 +250,9 @@ def simulate(
     nh = hinges.count if hinges.nonlinear else 0
     Q = hinges.operator(phi)[:nh]
     hst = hinges.initial_state()[:nh]
-    h_k, h_law, h_par, h_th0 = hinges.k[:nh], hinges.law[:nh], hinges.par[:nh], \
-        hinges.theta0[:nh]
+    # writable: a read-only array (a compiled model's) is another numba specialisation
+    h_k, h_law, h_par, h_th0 = (chk.writable(a[:nh]) for a in
+                                (hinges.k, hinges.law, hinges.par, hinges.theta0))
     rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
     buf = _Buffers(chunk + 1, nb, m, nh)
     keep = _Kept(n_keep, nb, m, track_energy, nh)
