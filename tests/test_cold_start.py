@@ -2,10 +2,11 @@
 
 numba caches each compiled specialisation on disk; a second process that meets argument types
 the warm-up did not build (read-only arrays from a compiled model, a vertical record, Newmark,
-the rigid companion, nonlinear connections) would compile for 30-70 s. This test runs those paths in a fresh process
-and reads numba's own dispatcher statistics: every kernel call must be a cache hit and none a
-cache miss (a miss is a compilation). Reference: numba's ``Dispatcher.stats`` (cache_hits,
-cache_misses) — https://numba.readthedocs.io, "Notes on caching".
+the rigid companion, nonlinear connections) would compile for 30-70 s. This test runs those
+paths in a fresh process and reads numba's own dispatcher statistics: every kernel call must be
+a cache hit and none a cache miss (a miss is a compilation). Reference: numba's
+``Dispatcher.stats`` (cache_hits, cache_misses) — https://numba.readthedocs.io, "Notes on
+caching".
 """
 
 from __future__ import annotations

@@ -275,3 +275,17 @@ def test_hinge_peaks_do_not_depend_on_decimation():
     for a, b in zip(full, dec, strict=True):
         assert b["peak_rotation_rad"] == pytest.approx(a["peak_rotation_rad"], rel=1e-12)
         assert b["peak_moment_Nm"] == pytest.approx(a["peak_moment_Nm"], rel=1e-12)
+
+
+def test_study_runs_use_the_hinge_basis():
+    """A study builds the basis once per rack (studies.executors._basis); with nonlinear
+    connections it must be run_rack's hinge-augmented Ritz basis, not the elastic one."""
+    from seisrack.studies.executors import _basis
+
+    model = _nonlinear_rack(0.5)
+    rec = _record(8.0, 2.0)
+    bas = _basis(model)
+    direct = run_rack(model, rec, dt=0.005)
+    assert bas.size == direct.history.basis["size"] == 16
+    via = run_rack(model, rec, dt=0.005, basis=bas)
+    np.testing.assert_array_equal(via.hinges.moment, direct.hinges.moment)

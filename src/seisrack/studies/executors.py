@@ -165,12 +165,14 @@ def _operators(model, basis):  # noqa: ANN001, ANN202
 def _basis(model):  # noqa: ANN001, ANN202
     """The basis ``run_rack(basis="auto")`` would build (or "auto": built by every run)."""
     try:
+        from seisrack.analysis.hinges import rack_hinges
         from seisrack.analysis.rack import rack_basis
         from seisrack.dynamics.sliders import Sliders
 
         sliders = Sliders(model.pallet_dof, model.pallet_mass, model.pallet_mu_static,
                           model.pallet_mu_dynamic)
-        return rack_basis(model, sliders, "auto", None)
+        # nonlinear connections: the Ritz basis needs their hinge vectors, as in run_rack
+        return rack_basis(model, sliders, "auto", None, rack_hinges(model))
     except (ImportError, TypeError):  # pragma: no cover - an engine without this helper
         return "auto"
 
