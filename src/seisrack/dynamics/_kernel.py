@@ -318,8 +318,8 @@ def run_kernel(
                 E_in += dq_in
                 E_damp += dd
             if nh > 0:
-                E_z += _hinge_commit(Q, hth0, hk, hlaw, hpar, hst, hst_t, q1, hM, hz,
-                                     not any_ev)
+                E_z += _hinge_commit(Q, hth0, hk, hlaw, hpar, hst, hst_t, q1, hM, hz, hM_t,
+                                     hz_t, not any_ev)
             T0[:] = T1
             S0[:] = S1
             if tau_end >= 1.0:

@@ -33,7 +33,7 @@ try:  # names injected by the loader when executed after ``_hysteresis.py`` and 
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._contact import _newmark_end
     from seisrack.dynamics._events import _JIT
-    from seisrack.dynamics._hysteresis import HYST_S_M, HYST_S_THETA, _hyst_trial_at
+    from seisrack.dynamics._hysteresis import HYST_S_THETA, _hyst_trial_at
     from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve_into
 
 STATUS_NEWTON = 4
@@ -211,30 +211,21 @@ def _nl_trial(
 
 
 @_JIT
-def _hinge_commit(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, fresh):
+def _hinge_commit(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, q1, hM, hz, hM_t, hz_t, fresh):
     """Commit the hinges at the accepted end state ``q1``; returns the correction forces' work
     ``∫ z dθ`` over the sub-step (trapezoid, as Newmark's energy identity needs).
 
-    ``fresh``: the accepted state is the last trial's, whose hinge states ``hst_t`` are
-    current; otherwise (an event was located, the accepted state may be an earlier trial) they
-    are recomputed at ``q1`` (the laws depend only on the committed state and θ).
+    ``fresh``: the accepted state is the last trial's, whose hinge states ``hst_t``, ``hM_t``,
+    ``hz_t`` are current; otherwise (an event was located, the accepted state may be an earlier
+    trial) they are recomputed at ``q1`` (the laws depend only on the committed state and θ).
     """
-    nh = hk.shape[0]
+    if not fresh:
+        _hinge_state(Q, hth0, hk, hlaw, hpar, hst_c, q1, hst_t, hM_t, hz_t)
     work = 0.0
-    for i in range(nh):
-        th0 = hst_c[i, HYST_S_THETA]
-        z0 = hz[i]
-        if fresh:
-            th1 = hst_t[i, HYST_S_THETA]
-            Mi = hst_t[i, HYST_S_M]
-        else:
-            th1 = hth0[i]
-            for k in range(Q.shape[1]):
-                th1 += Q[i, k] * q1[k]
-            Mi, _kt = _hyst_trial_at(hlaw[i], hpar, hst_c, i, th1, hst_t)
-        hM[i] = Mi
-        hz[i] = Mi - hk[i] * th1
-        work += 0.5 * (z0 + hz[i]) * (th1 - th0)
+    for i in range(hk.shape[0]):
+        work += 0.5 * (hz[i] + hz_t[i]) * (hst_t[i, HYST_S_THETA] - hst_c[i, HYST_S_THETA])
+        hM[i] = hM_t[i]
+        hz[i] = hz_t[i]
         for c in range(hst_c.shape[1]):
             hst_c[i, c] = hst_t[i, c]
     return work

@@ -12,7 +12,6 @@ beyond 500 DOFs (the P-Δ buckling factor of a small rack is a dense LAPACK solv
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 
 import numpy as np
@@ -25,7 +24,7 @@ from seisrack.fe.assembly import assemble_sparse, symmetric_csr
 from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.fe.modal import modal_from_matrices
 from seisrack.fe.stability import is_positive_definite
-from seisrack.model.frame_model import FrameModel
+from seisrack.model.frame_model import FrameModel, read_only
 from seisrack.model.rack_mesh import RackMesh, build_rack_mesh
 from seisrack.model.spec import Connections, Pallet, RackSpec
 
@@ -74,7 +73,7 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     member_mass = float(np.sum(mesh.density * mesh.A * mesh.lengths))
     log.info("compiled rack: %d nodes, %d elements, %d DOFs, %d pallets",
              mesh.nodes.shape[0], mesh.n_el, mesh.n_dof, n_p)
-    return _read_only(FrameModel(
+    return read_only(FrameModel(
         mesh=mesh, K_sparse=K, M_sparse=M, C_sparse=C, damping_coefficients=(a0, a1),
         r_x=r_x, r_y=r_y, pallet_dof=p_dof, pallet_vdof=p_vdof, pallet_node=p_node,
         pallet_mass=p_mass,
@@ -177,24 +176,6 @@ def sliding_limits(spec: RackSpec) -> tuple[FloatArray, FloatArray]:
         if p.sliding_limit is not None:
             neg[i] = pos[i] = p.sliding_limit
     return neg, pos
-
-
-def _read_only(model: FrameModel) -> FrameModel:
-    """Lock every array of the compiled model (it is shared, never mutated).
-
-    Sparse matrices are locked through their ``data``, ``indices`` and ``indptr`` arrays; they
-    are canonical, so SciPy never needs to sort or merge them in place.
-    """
-    for obj in (model, model.mesh):
-        for f in dataclasses.fields(obj):
-            value = getattr(obj, f.name)
-            for arr in value if isinstance(value, tuple) else (value,):
-                if sp.issparse(arr):
-                    for part in (arr.data, arr.indices, arr.indptr):
-                        part.flags.writeable = False
-                elif isinstance(arr, np.ndarray):
-                    arr.flags.writeable = False
-    return model
 
 
 def _diagonal(dofs: np.ndarray, values: FloatArray, n_dof: int) -> sp.csr_matrix:

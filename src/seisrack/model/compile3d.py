@@ -26,6 +26,7 @@ from seisrack.fe.assembly3d import assemble_sparse_3d
 from seisrack.fe.modal import modal_from_matrices
 from seisrack.fe.stability import is_positive_definite
 from seisrack.model.dimension import RUN_3D_MESSAGE, require_2d  # noqa: F401  (re-exported)
+from seisrack.model.frame_model import read_only
 from seisrack.model.frame_model3d import FrameModel3D
 from seisrack.model.rack_mesh3d import RackMesh3D, build_rack_mesh_3d
 from seisrack.model.spec import Connections, RackSpec
@@ -77,7 +78,7 @@ def compile_rack_3d(spec: RackSpec) -> FrameModel3D:
     log.info("compiled 3D rack: %d nodes, %d beam-columns, %d bars, %d DOFs, %d pallets",
              mesh.nodes.shape[0], mesh.elements.shape[0], mesh.trusses.shape[0], mesh.n_dof,
              n_p)
-    return _read_only(dataclasses.replace(
+    return read_only(dataclasses.replace(
         model, r_theta=r_t, plan_centre=centre, damping_coefficients=(a0, a1),
         C_sparse=symmetric_csr(a0 * M + a1 * K)))
 
@@ -187,16 +188,3 @@ def _damping(spec: RackSpec, K: sp.csr_matrix, Mt: sp.csr_matrix, r_x: np.ndarra
     if d.kind == "rayleigh":
         return fe_damping.rayleigh(d.pairs)
     return 0.0, 0.0
-
-
-def _read_only(model: FrameModel3D) -> FrameModel3D:
-    for obj in (model, model.mesh):
-        for f in dataclasses.fields(obj):
-            value = getattr(obj, f.name)
-            for arr in value if isinstance(value, tuple) else (value,):
-                if sp.issparse(arr):
-                    for part in (arr.data, arr.indices, arr.indptr):
-                        part.flags.writeable = False
-                elif isinstance(arr, np.ndarray):
-                    arr.flags.writeable = False
-    return model

@@ -8,10 +8,11 @@ memory; dense views exist for small racks and for code that has not moved to spa
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import cached_property
 from typing import Any
 
+import numpy as np
 import scipy.sparse as sp
 
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
@@ -194,3 +195,21 @@ def _dense(A: sp.spmatrix) -> FloatArray:
     out = A.toarray()
     out.flags.writeable = False
     return out
+
+
+def read_only(model: Any) -> Any:
+    """Lock every array of a compiled model, 2D or 3D (it is shared, never mutated).
+
+    Sparse matrices are locked through their ``data``, ``indices`` and ``indptr`` arrays; they
+    are canonical, so SciPy never needs to sort or merge them in place.
+    """
+    for obj in (model, model.mesh):
+        for f in fields(obj):
+            value = getattr(obj, f.name)
+            for arr in value if isinstance(value, tuple) else (value,):
+                if sp.issparse(arr):
+                    for part in (arr.data, arr.indices, arr.indptr):
+                        part.flags.writeable = False
+                elif isinstance(arr, np.ndarray):
+                    arr.flags.writeable = False
+    return model
