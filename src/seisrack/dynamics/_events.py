@@ -96,6 +96,13 @@ def _bracket_start(br, stuck, sig, lam, N_lo, s_lo, mus, e_lo, T1, S1, Tb, Sb):
     """Open the bracket [0, 1] of the remaining sub-step: ``e_lo`` from the start state, the
     hi end is the current trial (``T1``, ``S1`` copied to ``Tb``, ``Sb``)."""
     _event_values(stuck, sig, lam, N_lo, s_lo, mus, e_lo)
+    _bracket_open(br, T1, S1, Tb, Sb)
+
+
+@_JIT
+def _bracket_open(br, T1, S1, Tb, Sb):
+    """Open the bracket [0, 1] on event values the kernel computed itself (the planar kernel
+    has its own event functions): the hi end is the current trial."""
     Tb[:] = T1
     Sb[:] = S1
     br[0] = 0.0
@@ -156,8 +163,14 @@ def _accept_trial(br, th, stuck, sig, lam1, N_e, s1, mus, tolF, e_try, e_lo, e_h
     """Move a bracket end to the trial at ``th``; a trial that violates a contact state
     becomes the hi end (its state ``T1``, ``S1`` is kept in ``Tb``, ``Sb``)."""
     _event_values(stuck, sig, lam1, N_e, s1, mus, e_try)
+    _accept_values(br, th, e_try, tolF, e_lo, e_hi, T1, S1, Tb, Sb)
+
+
+@_JIT
+def _accept_values(br, th, e_try, tolF, e_lo, e_hi, T1, S1, Tb, Sb):
+    """:func:`_accept_trial` on event values ``e_try`` the kernel computed itself."""
     viol = False
-    for j in range(stuck.shape[0]):
+    for j in range(e_try.shape[0]):
         if e_try[j] > tolF[j]:
             viol = True
     side = 1.0 if viol else -1.0

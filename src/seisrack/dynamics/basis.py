@@ -100,6 +100,7 @@ def reduced_basis(
     M, K, slider_dof: np.ndarray, slider_mass: np.ndarray, loads: np.ndarray,  # noqa: ANN001, N803
     *, tol: float = DEFAULT_TOL, blocks: int = DEFAULT_BLOCKS,
     target_size: int = DEFAULT_TARGET_SIZE, max_size: int = DEFAULT_MAX_SIZE,
+    unit_loads: bool = True,
 ) -> Basis:
     """Load-dependent Ritz basis (Wilson, Yuan & Dickens 1982; block form).
 
@@ -114,7 +115,9 @@ def reduced_basis(
     ``(K, M)`` makes the basis M-orthonormal and K-diagonal.
 
     M, K: (n, n) dense or sparse; slider_dof, slider_mass: (m,) (dof -1: on the ground);
-    loads: (n, k) load patterns [N per unit of their time series].
+    loads: (n, k) load patterns [N per unit of their time series]. unit_loads: False when the
+    caller's ``loads`` already hold the sliders' force patterns (a pallet resting on several
+    nodes pushes them together), so no unit force per slider DOF is added.
     """
     n = K.shape[0]
     if not (np.isfinite(tol) and 0 < tol < 1):
@@ -141,7 +144,7 @@ def reduced_basis(
             "K", "singular", "a stable structure (positive-definite stiffness)"
         ) from exc
     loads = np.asarray(loads, dtype=float).reshape(n, -1)
-    udofs = np.unique(dof[on])
+    udofs = np.unique(dof[on]) if unit_loads else np.zeros(0, dtype=np.int64)
     F = np.zeros((n, loads.shape[1] + udofs.size))
     F[:, : loads.shape[1]] = loads
     F[udofs, loads.shape[1] + np.arange(udofs.size)] = 1.0

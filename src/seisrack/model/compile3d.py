@@ -28,6 +28,7 @@ from seisrack.fe.stability import is_positive_definite
 from seisrack.model.dimension import RUN_3D_MESSAGE, require_2d  # noqa: F401  (re-exported)
 from seisrack.model.frame_model import read_only
 from seisrack.model.frame_model3d import FrameModel3D
+from seisrack.model.pallet_layout3d import pallet_layout_3d
 from seisrack.model.rack_mesh3d import RackMesh3D, build_rack_mesh_3d
 from seisrack.model.spec import Connections, RackSpec
 
@@ -62,6 +63,9 @@ def compile_rack_3d(spec: RackSpec) -> FrameModel3D:
                                for p in spec.pallets], dtype=float),
         pallet_overhang=np.array([math.nan if p.overhang is None else p.overhang
                                   for p in spec.pallets], dtype=float),
+        pallet_level=np.array([p.level for p in spec.pallets], dtype=np.int64),
+        pallet_bay=np.array([p.bay for p in spec.pallets], dtype=np.int64),
+        layout=pallet_layout_3d(spec),
         element_kind=rm.element_kind, element_storey=rm.element_storey,
         element_line=rm.element_line, element_side=rm.element_side, truss_kind=rm.truss_kind,
         truss_line=rm.truss_line, base_nodes=rm.base_nodes, level_nodes=rm.level_nodes,

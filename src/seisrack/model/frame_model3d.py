@@ -14,6 +14,7 @@ import scipy.sparse as sp
 
 from seisrack.fe.mesh import FloatArray, IntArray
 from seisrack.model.frame_model import FrameModel
+from seisrack.model.pallet_layout3d import PalletLayout3D
 from seisrack.model.rack_mesh3d import Mesh3D
 
 
@@ -38,6 +39,9 @@ class FrameModel3D:
         pallet_node, pallet_dof_x, pallet_dof_z, pallet_vdof: (n_pallet, 2) int, [front, rear].
         pallet_mass [kg], pallet_mu_static, pallet_mu_dynamic [-]: (n_pallet,).
         pallet_depth, pallet_overhang: (n_pallet,) [m], nan when not given.
+        layout: fall distances cross-aisle and down-aisle contact gaps
+        (:class:`~seisrack.model.pallet_layout3d.PalletLayout3D`).
+        pallet_level, pallet_bay: (n_pallet,) 1-based, as in the TOML.
 
     Layout:
         mesh: the :class:`~seisrack.model.rack_mesh3d.Mesh3D`.
@@ -68,6 +72,8 @@ class FrameModel3D:
     pallet_mu_dynamic: FloatArray
     pallet_depth: FloatArray
     pallet_overhang: FloatArray
+    pallet_level: IntArray
+    pallet_bay: IntArray
     element_kind: IntArray
     element_storey: IntArray
     element_line: IntArray
@@ -85,6 +91,7 @@ class FrameModel3D:
     g: float
     title: str = ""
     critical_load_factor: float | None = None
+    layout: PalletLayout3D | None = None
 
     is_3d = True
 

@@ -1,0 +1,125 @@
+"""Falls and impacts of the pallets of a 3D rack, tracked over every step of a run (issue 11,
+item 4; geometry: :mod:`seisrack.model.pallet_layout3d`).
+
+A pallet *falls* cross-aisle the first time its sliding passes its fall distance towards the
+front aisle (−z) or the rear (+z). A down-aisle *impact* is the first time a gap closes
+between two neighbouring pallets, or between an end pallet and its upright; it is reported
+with its closing speed. Crossing times are interpolated linearly between samples. The run
+does not follow a pallet beyond either event (it stays on its beams in the model), so what
+happens to a pallet after its fall or impact is not physical: the tracker reports first
+occurrences only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from seisrack.model.pallet_layout3d import UPRIGHT, PalletLayout3D
+
+
+@dataclass(frozen=True)
+class Fall:
+    """Pallet ``pallet`` (0-based) falls towards ``side`` ("front" aisle, −z, or "rear", +z)
+    at ``time_s``."""
+
+    pallet: int
+    time_s: float
+    side: str
+
+
+@dataclass(frozen=True)
+class Impact:
+    """First contact down-aisle: pallet ``left`` (at smaller x) against ``right`` (either may be
+    UPRIGHT = −1) at ``time_s`` with closing speed ``speed_m_s`` (> 0)."""
+
+    left: int
+    right: int
+    time_s: float
+    speed_m_s: float
+
+
+def _first_crossing(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each column of ``f`` (k, c) that reaches f >= 0: its first row and the fraction of
+    the previous interval at which it crosses (linear)."""
+    hit = f >= 0.0
+    cols = np.flatnonzero(hit.any(axis=0))
+    rows = hit[:, cols].argmax(axis=0)
+    pos = rows.astype(float)
+    ok = rows > 0
+    f0 = f[rows[ok] - 1, cols[ok]]
+    f1 = f[rows[ok], cols[ok]]
+    den = np.where(f1 - f0 > 0, f1 - f0, 1.0)
+    pos[ok] = rows[ok] - 1 + np.clip(-f0 / den, 0.0, 1.0)
+    return cols, pos
+
+
+class ContactTracker:
+    """Peaks of sliding (x, z, magnitude), falls and impacts over the chunks of a run."""
+
+    def __init__(self, layout: PalletLayout3D, n_pallets: int) -> None:
+        self.layout = layout
+        m = n_pallets
+        self.peak = np.zeros((m, 3))
+        self.fall_time = np.full(m, np.nan)
+        self.fall_side = np.zeros(m, dtype=np.int64)  # -1 front, +1 rear
+        k = layout.contact_gap.size
+        self.impact_time = np.full(k, np.nan)
+        self.impact_speed = np.full(k, np.nan)
+
+    def update(self, t: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
+        """One chunk: times (k,), sliding and sliding velocity (k, m, 2)."""
+        if u.shape[1] == 0:
+            return
+        ax = np.abs(u)
+        np.maximum(self.peak[:, 0], ax[:, :, 0].max(axis=0), out=self.peak[:, 0])
+        np.maximum(self.peak[:, 1], ax[:, :, 1].max(axis=0), out=self.peak[:, 1])
+        np.maximum(self.peak[:, 2], np.hypot(u[:, :, 0], u[:, :, 1]).max(axis=0),
+                   out=self.peak[:, 2])
+        lay = self.layout
+        open_ = np.flatnonzero(np.isnan(self.fall_time) & np.isfinite(lay.fall_front))
+        if open_.size:
+            uz = u[:, open_, 1]
+            for sign, limit in ((-1, lay.fall_front), (1, lay.fall_rear)):
+                cols, rows = _first_crossing(sign * uz - limit[open_])
+                for c, r in zip(cols, rows, strict=True):
+                    p = open_[c]
+                    tr = float(np.interp(r, np.arange(t.size), t))
+                    if np.isnan(self.fall_time[p]) or tr < self.fall_time[p]:
+                        self.fall_time[p] = tr
+                        self.fall_side[p] = sign
+        todo = np.flatnonzero(np.isnan(self.impact_time))
+        if todo.size:
+            ux = np.zeros((t.size, u.shape[1] + 1))
+            vx = np.zeros_like(ux)
+            ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
+            vx[:, :-1] = v[:, :, 0]
+            left, right = lay.contact_left[todo], lay.contact_right[todo]
+            close = ux[:, left] - ux[:, right] - lay.contact_gap[todo]
+            speed = vx[:, left] - vx[:, right]
+            cols, rows = _first_crossing(close)
+            grid = np.arange(t.size)
+            for c, r in zip(cols, rows, strict=True):
+                self.impact_time[todo[c]] = float(np.interp(r, grid, t))
+                self.impact_speed[todo[c]] = float(np.interp(r, grid, speed[:, c]))
+
+    def falls(self) -> list[Fall]:
+        idx = np.flatnonzero(np.isfinite(self.fall_time))
+        out = [Fall(int(p), float(self.fall_time[p]),
+                    "front" if self.fall_side[p] < 0 else "rear") for p in idx]
+        return sorted(out, key=lambda f: f.time_s)
+
+    def impacts(self) -> list[Impact]:
+        lay = self.layout
+        idx = np.flatnonzero(np.isfinite(self.impact_time))
+        out = [Impact(int(lay.contact_left[c]), int(lay.contact_right[c]),
+                      float(self.impact_time[c]), float(self.impact_speed[c])) for c in idx]
+        return sorted(out, key=lambda i: i.time_s)
+
+
+def describe_contact(impact: Impact) -> str:
+    """'pallet 3 / pallet 4', 'upright / pallet 1' (1-based pallet numbers)."""
+    def name(i: int) -> str:
+        return "upright" if i == UPRIGHT else f"pallet {i + 1}"
+    return f"{name(impact.left)} / {name(impact.right)}"
