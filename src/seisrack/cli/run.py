@@ -48,6 +48,12 @@ def register(subparsers: Any) -> None:
                                    ".AT2 or seisrack CSV files)")
     p.add_argument("--motion-dt", type=float, metavar="DT",
                    help="[s] time step of a one-column record file")
+    p.add_argument("--motion-cross", metavar="FILE",
+                   help="3D racks: cross-aisle ground acceleration (the second horizontal "
+                        "component; same units, dt and length as --motion)")
+    p.add_argument("--angle", type=float, default=0.0, metavar="DEG",
+                   help="3D racks: incidence angle [deg] turning the horizontal pair from the "
+                        "down-aisle axis towards the cross-aisle one (default 0)")
     p.add_argument("--vertical", metavar="FILE",
                    help="vertical ground acceleration, same units, dt and length as the "
                         "horizontal record (pallet normal forces become m (g + a_v))")
@@ -322,6 +328,13 @@ def run(args: argparse.Namespace) -> int:
     if args.mu is not None:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
     model = compile_rack(spec)
+    if getattr(model, "is_3d", False):
+        from seisrack.cli.run3d import run_3d
+
+        return run_3d(args, spec, model)
+    from seisrack.cli.run3d import check_2d_options
+
+    check_2d_options(args)
     rec, vert = _records(args)
     rec, vert, scaling = _apply_scaling(args, model, rec, vert)
     _input_warnings(rec, vert, model.g, scaling is not None)

@@ -44,11 +44,8 @@ class GroundMotion3D:
 
     @property
     def name(self) -> str:
-        parts = [self.names[0] or "-", self.names[1] or "-"]
-        label = " / ".join(parts)
-        if self.angle_deg:
-            label += f" at {self.angle_deg:g} deg"
-        return label
+        """'down / cross' record names ('-' where a component is absent)."""
+        return " / ".join([self.names[0] or "-", self.names[1] or "-"])
 
     def peak_horizontal(self) -> float:
         """[m/s²] largest magnitude of the horizontal acceleration vector."""
