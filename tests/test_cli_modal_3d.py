@@ -62,9 +62,9 @@ def test_plot_functions_return_axes():
     plt.close("all")
 
 
-def test_run_on_3d_rack_is_a_clear_error(capsys):
-    code = main(["run", str(RACK), "--builtin", "elcentro_1940_ns", "--json"])
+def test_report_on_3d_rack_is_a_clear_error(capsys):
+    code = main(["report", str(RACK), "--builtin", "elcentro_1940_ns", "--json"])
     assert code == 2
     err = json.loads(capsys.readouterr().out)["error"]
     assert err["field"] == "geometry.depth"
-    assert "use seisrack modal" in err["message"]
+    assert "seisrack run" in err["message"]

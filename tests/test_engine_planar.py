@@ -279,3 +279,19 @@ def test_bad_run_input():
         simulate_planar(M, Cn, K, sl, dt=0.01, ground_x=ag, influence_x=[1, 1, 0, 0],
                         basis="full")
     assert exc.value.field == "C"
+
+
+def test_vertical_component_scales_the_friction_like_the_1d_engine():
+    M, C, K = _frame()
+    dt = 0.005
+    t = np.arange(0, 6 + dt / 2, dt)
+    ag = 4.0 * np.sin(2 * np.pi * 1.1 * t)
+    av = 3.0 * np.sin(2 * np.pi * 3.3 * t)
+    kw = dict(dt=dt, vertical_accel=av, basis="full")
+    hp = simulate_planar(M, C, K, PlanarSliders([0, 1], [2, 3], [400.0, 300.0], 0.3, 0.25),
+                         ground_x=ag, influence_x=[1, 1, 0, 0], **kw)
+    h1 = simulate(M[:2, :2], C[:2, :2], K[:2, :2], Sliders([0, 1], [400.0, 300.0], 0.3, 0.25),
+                  ground_accel=ag, method="newmark", **kw)
+    peak = np.abs(h1.sliding).max()
+    assert np.allclose(hp.normal, h1.normal)
+    assert np.abs(hp.sliding[:, :, 0] - h1.sliding).max() < 1e-8 * peak

@@ -1,12 +1,12 @@
-"""2D or 3D: the guard for what only the 2D rack supports yet (time histories, reports,
-exports), shared by the 3D spec, mesh and compiled model."""
+"""2D or 3D: the guard for what only the 2D rack supports yet (the engineer's report,
+studies, exports, the 2D time history API), shared by the 3D spec, mesh and compiled model."""
 
 from __future__ import annotations
 
 from seisrack.errors import InputError
 
-RUN_3D_MESSAGE = ("3D time histories are not available yet; use seisrack modal (a 3D rack "
-                  "supports modal analysis only for now)")
+RUN_3D_MESSAGE = ("3D racks support seisrack modal and seisrack run for now; the engineer's "
+                  "report, studies and the OpenSees export are 2D-only")
 
 
 def require_2d(spec_or_model: object, field: str = "geometry.depth",
@@ -19,5 +19,5 @@ def require_2d(spec_or_model: object, field: str = "geometry.depth",
             depth = getattr(spec_or_model, "depth", None)
         if depth is None:
             depth = spec_or_model.geometry.depth  # type: ignore[attr-defined]
-        raise InputError(field, depth, "a 2D rack (no [geometry] depth) for time histories, "
-                         "reports and exports", hint=RUN_3D_MESSAGE)
+        raise InputError(field, depth, "a 2D rack (no [geometry] depth) for this command "
+                         "(reports, studies, exports)", hint=RUN_3D_MESSAGE)
