@@ -39,12 +39,14 @@ _BASES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 @dataclass(frozen=True)
 class RackResponse3D:
-    """Result of :func:`run_rack_3d` (SI units; pallets 0-based here, 1-based in summaries).
+    """Result of :func:`run_rack_3d` (SI units; pallet indices 0-based here, 1-based in
+    summaries; ``pallet_level`` and ``pallet_bay`` are 1-based, as in the TOML).
 
     history: the engine's kept samples; t: their times [s]. ground: (n_t, 3) ground
     acceleration x, z, vertical at those times [m/s²].
     peak_sliding: (m, 3) [m] peak |sliding| down-aisle (x), cross-aisle (z) and in magnitude,
-    over every step; residual: (m, 2) [m] sliding at the end.
+    over every step (a pallet's values after its fall time are not physical: the model keeps
+    it on its beams); residual: (m, 2) [m] sliding at the last step.
     level_peak: (n_level, 2) [m] peak mean displacement of each beam level, x and z.
     falls, impacts: first occurrences (see :mod:`seisrack.analysis.pallet_contacts`).
     """
@@ -129,6 +131,10 @@ class RackResponse3D:
                        "stick": sum(e.kind == "stick" for e in ev),
                        "turn": sum(e.kind == "reverse" for e in ev)},
             "basis": self.history.basis,
+            "notes": ([] if not self.falls else [
+                "the model keeps a fallen pallet on its beams: its peaks and residual after "
+                "the fall time are not physical"]) + ([] if not self.impacts else [
+                "impacts are first contacts; the pallets are not stopped by them in the model"]),
             "pallets": self.pallet_peaks(),
         }
 
@@ -221,5 +227,6 @@ def run_rack_3d(
         angle_deg=motion.angle_deg, dt=step, pallet_level=np.asarray(model.pallet_level),
         pallet_bay=np.asarray(model.pallet_bay), peak_sliding=tracker.peak.copy(),
         residual=hist.sliding[-1].copy() if hist.sliding.shape[1] else np.zeros((0, 2)),
-        level_peak=level_peak, level_y=np.asarray(model.level_y), fall_front=lay.fall_front,
-        fall_rear=lay.fall_rear, falls=tracker.falls(), impacts=tracker.impacts())
+        level_peak=level_peak, level_y=np.asarray(model.level_y),
+        fall_front=lay.fall_front.copy(), fall_rear=lay.fall_rear.copy(), falls=tracker.falls(),
+        impacts=tracker.impacts())

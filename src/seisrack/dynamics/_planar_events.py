@@ -1,0 +1,229 @@
+"""Contact decisions of the planar stick–slip kernel at an event, its event values and its
+output (source shared by the numba and pure-Python backends; theory:
+``docs/theory/planar_friction.md`` §3). Location itself is the shared event core's
+(``_events.py``).
+"""
+
+# ruff: noqa: N803, N806  (matrix names follow the equations)
+
+import numpy as np
+
+try:  # names injected by the loader when executed after ``_planar_step.py``
+    _chol  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._events import _JIT, KIND_REVERSE, KIND_SLIP, KIND_STICK
+    from seisrack.dynamics._planar_step import _chol, _chol_solve, _s_update
+
+@_JIT
+def _start_values(stuck, mus, N0, S0, e_lo):
+    """Event values at the start of a sub-step (the bracket's lo end)."""
+    lam, s = S0[3], S0[4]
+    for p in range(stuck.shape[0]):
+        jx = 2 * p
+        if stuck[p]:
+            e_lo[p] = np.sqrt(lam[jx] ** 2 + lam[jx + 1] ** 2) - mus[p] * N0[p]
+        else:
+            e_lo[p] = -np.sqrt(s[jx] ** 2 + s[jx + 1] ** 2)
+
+
+@_JIT
+def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand, forced,
+            A, base, frozen):
+    """Contact state at an instant and consistent accelerations (active set).
+
+    ``cand``: pallets at zero relative velocity to be decided (they stick when the force that
+    keeps them stuck is within mu_s N, else slide opposite to it); ``forced``: stuck pallets
+    whose slip onset was just located (at mu_s N to the location's tolerance). Every one starts
+    stuck and the most overloaded is released, one at a time, the forced ones from 1 - 1e-7 of
+    their capacity: when several reach their threshold together, releasing one can unload the
+    others (an all-at-once release chattered, each pallet re-sticking at once). Updates
+    ``stuck``, ``dirn`` and ``S`` (the stuck pallets' mass); writes qdd, wdd and lam.
+    ``frozen`` pallets keep their state (see ``_CHATTER``).
+    """
+    r = kd.shape[0]
+    m = mass.shape[0]
+    q, qd, qdd = T0[0], T0[1], T0[2]
+    wdd, lam = S0[2], S0[3]
+    for p in range(m):
+        if cand[p] and not stuck[p]:
+            stuck[p] = True
+            _s_update(S, P, mass, p, 1.0)
+    for _it in range(2 * m + 2):
+        # (I + S) qdd = pext - C qd - K q - sum_F P_pᵀ lam_p - sum_S m_p P_pᵀ ag
+        for i in range(r):
+            base[i] = pext[i] - cd[i] * qd[i] - kd[i] * q[i]
+        for p in range(m):
+            for c in range(2):
+                j = 2 * p + c
+                if stuck[p]:
+                    f = mass[p] * ag[c]
+                else:
+                    f = -mud[p] * N[p] * dirn[j]
+                    lam[j] = f
+                for i in range(r):
+                    base[i] -= P[j, i] * f
+        for i in range(r):
+            for k in range(r):
+                A[i, k] = S[i, k]
+            A[i, i] += 1.0
+        _chol(A)
+        _chol_solve(A, base)
+        for i in range(r):
+            qdd[i] = base[i]
+        worst = -1
+        worst_ratio = 1.0 + 1e-12
+        for p in range(m):
+            if not stuck[p]:
+                continue
+            for c in range(2):
+                j = 2 * p + c
+                acc = 0.0
+                for i in range(r):
+                    acc += P[j, i] * qdd[i]
+                lam[j] = mass[p] * (acc + ag[c])
+            mag = np.sqrt(lam[2 * p] ** 2 + lam[2 * p + 1] ** 2)
+            cap = mus[p] * N[p]
+            ratio = mag / cap if cap > 0.0 else (np.inf if mag > 0.0 else 0.0)
+            if frozen[p]:
+                continue
+            if forced[p]:
+                ratio += 1e-7 + 1e-12  # released from 1 - 1e-7 of the capacity
+            if ratio > worst_ratio:
+                worst_ratio = ratio
+                worst = p
+        if worst < 0:
+            break
+        stuck[worst] = False
+        _s_update(S, P, mass, worst, -1.0)
+        _slide_away(lam, dirn, worst)
+    for p in range(m):
+        for c in range(2):
+            j = 2 * p + c
+            if stuck[p]:
+                acc = 0.0
+                for i in range(r):
+                    acc += P[j, i] * qdd[i]
+                wdd[j] = acc
+            else:
+                wdd[j] = -ag[c] + lam[j] / mass[p]
+
+
+@_JIT
+def _slide_away(lam, dirn, p):
+    """Sliding direction of a pallet released from stick: opposite to its holding force."""
+    fx = lam[2 * p]
+    fz = lam[2 * p + 1]
+    fn = np.sqrt(fx * fx + fz * fz)
+    if fn > 0.0:
+        dirn[2 * p] = -fx / fn
+        dirn[2 * p + 1] = -fz / fn
+
+
+@_JIT
+def _record(old_stuck, stuck, turned, t_e, n_ev, max_events, ev_time, ev_pallet, ev_kind):
+    for p in range(stuck.shape[0]):
+        kind = -1
+        if old_stuck[p] and not stuck[p]:
+            kind = KIND_SLIP
+        elif stuck[p] and not old_stuck[p]:
+            kind = KIND_STICK
+        elif turned[p] and not stuck[p]:
+            kind = KIND_REVERSE
+        if kind >= 0:
+            if n_ev < max_events:
+                ev_time[n_ev] = t_e
+                ev_pallet[n_ev] = p
+                ev_kind[n_ev] = kind
+            n_ev += 1
+    return n_ev
+
+
+@_JIT
+def _classify(stuck, dirn, mus, N, S0, e, cand, forced, old_stuck, turned, c_full, frozen):
+    """Pallets whose state must be decided at an event: slip onsets (``forced``, sliding
+    opposite to their holding force) and pallets at zero relative velocity (``cand``; a sliding
+    one is snapped onto its support's velocity)."""
+    wd, lam, s, vn = S0[1], S0[3], S0[4], S0[5]
+    old_stuck[:] = stuck
+    for p in range(stuck.shape[0]):
+        cand[p] = False
+        forced[p] = False
+        turned[p] = False
+        jx = 2 * p
+        jz = jx + 1
+        if frozen[p]:
+            continue
+        if stuck[p]:
+            mag = np.sqrt(lam[jx] ** 2 + lam[jz] ** 2)
+            if mag - mus[p] * N[p] > -1e-7 * mus[p] * N[p] - 1e-300:
+                forced[p] = True
+                _slide_away(lam, dirn, p)
+            else:
+                cand[p] = True
+        else:
+            vs = (np.sqrt(wd[jx] ** 2 + wd[jz] ** 2) + np.sqrt(vn[jx] ** 2 + vn[jz] ** 2)
+                  + 1e-30)
+            # a stop, unless the located event is a sharp turn with the pallet still sliding
+            # (then nothing changes: the next sub-step starts in the new direction); a stop
+            # leaves a velocity across d0 of the order of the turn, snapped to zero when below
+            # a tenth of what friction removes in half a step (an O(dt²) displacement)
+            sn = np.sqrt(s[jx] ** 2 + s[jz] ** 2)
+            if e[p] > -1e-9 * vs and sn <= max(0.1 * c_full[p], 1e-9 * vs):
+                cand[p] = True
+                wd[jx] = vn[jx]
+                wd[jz] = vn[jz]
+                s[jx] = 0.0
+                s[jz] = 0.0
+
+
+@_JIT
+def _mask_frozen(frozen, e):
+    for p in range(e.shape[0]):
+        if frozen[p]:
+            e[p] = -1e300
+
+
+@_JIT
+def _track_direction(stuck, S0, dirn):
+    """Sliding direction after a sub-step: opposite to the friction force (which is
+    -mu_d N ẑ)."""
+    lam = S0[3]
+    for p in range(stuck.shape[0]):
+        if not stuck[p]:
+            fx = lam[2 * p]
+            fz = lam[2 * p + 1]
+            fn = np.sqrt(fx * fx + fz * fz)
+            if fn > 0.0:
+                dirn[2 * p] = -fx / fn
+                dirn[2 * p + 1] = -fz / fn
+
+
+@_JIT
+def _fill_relative(P, T0, S0):
+    """Support velocity ``vn`` and relative velocity ``s`` of the state (after a transition)."""
+    qd = T0[1]
+    wd, s, vn = S0[1], S0[4], S0[5]
+    for j in range(P.shape[0]):
+        acc = 0.0
+        for i in range(P.shape[1]):
+            acc += P[j, i] * qd[i]
+        vn[j] = acc
+        s[j] = wd[j] - acc
+
+
+@_JIT
+def _output(k, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck):
+    out_q[k, :] = T0[0]
+    out_qd[k, :] = T0[1]
+    out_qdd[k, :] = T0[2]
+    q = T0[0]
+    w = S0[0]
+    for j in range(P.shape[0]):
+        acc = 0.0
+        for i in range(P.shape[1]):
+            acc += P[j, i] * q[i]
+        out_u[k, j] = w[j] - acc
+    out_v[k, :] = S0[4]
+    out_lam[k, :] = S0[3]
+    for p in range(stuck.shape[0]):
+        out_stuck[k, p] = stuck[p]
