@@ -63,6 +63,7 @@ def main() -> None:
     b = generate_ec8_record(ag=0.25, duration=20.0, dt=0.01, seed=2)
     motion = combine(a, b)
     load0 = os.getloadavg()
+    commit = _commit()  # at the start: the code this process imports
     start = time.perf_counter()
     rows = []
     with threadpool_limits(1):
@@ -74,7 +75,7 @@ def main() -> None:
         "# 3D racks with planar sliding pallets: run time",
         "",
         f"Written by `benchmarks/rack3d.py` ({dt.datetime.now(dt.UTC):%Y-%m-%d %H:%M} UTC, "
-        f"{(time.perf_counter() - start) / 60:.1f} min) at commit {_commit()}. Reports numbers; "
+        f"{(time.perf_counter() - start) / 60:.1f} min) at commit {commit}. Reports numbers; "
         "never asserts on time.",
         "",
         f"- Machine: {platform.machine()}, {os.cpu_count()} cores, {platform.platform()}, "
