@@ -43,18 +43,17 @@ def _check_3d_options(args: argparse.Namespace) -> None:
         raise InputError("--angle", args.angle, "an incidence angle in degrees, -360 to 360")
 
 
-def run_3d(args: argparse.Namespace, spec: Any, model: Any) -> int:
+def run_3d(args: argparse.Namespace, spec: Any, model: Any, progress_bar: Any) -> int:
+    """The 3D run; ``progress_bar(n_steps)`` gives a tqdm-like bar or None (the 2D run's)."""
     from seisrack.analysis import analysis_grid
     from seisrack.analysis.rack3d import run_rack_3d
     from seisrack.cli._common import print_json
-    from seisrack.cli.run import (
+    from seisrack.cli.run_inputs import (
         _apply_scaling,
         _input_warnings,
-        _need,
-        _prepare_out,
-        _progress_bar,
         _read,
         _records,
+        output_folder,
     )
     from seisrack.errors import InputError
     from seisrack.motion import scale_by
@@ -75,23 +74,11 @@ def run_3d(args: argparse.Namespace, spec: Any, model: Any) -> int:
         k = analysis_grid(motion, args.dt)  # type: ignore[arg-type]
     except InputError as exc:
         raise InputError("--dt", args.dt, exc.allowed) from None
-    plot = bool(args.out) if args.plot is None else bool(args.plot)
-    out = None
-    if args.out:
-        _need("xarray", "--out", args.out, "io")
-        if plot:
-            _need("matplotlib", "--plot", True, "plot")
-        out = _prepare_out(args.out)
-        if plot and not args.force:
-            from seisrack.report.sliding_paths import existing_figures_3d
+    from seisrack.report.sliding_paths import existing_figures_3d
 
-            there = existing_figures_3d(out)
-            if there:
-                raise InputError("--out", args.out, "a folder without seisrack figures, or "
-                                 "--force to overwrite them",
-                                 hint="Existing: " + ", ".join(p.name for p in there))
+    plot, out = output_folder(args, existing_figures_3d)
     n_pad = int(round(args.free_vibration / motion.dt))
-    bar = _progress_bar((motion.n - 1 + n_pad) * k)
+    bar = progress_bar((motion.n - 1 + n_pad) * k)
     try:
         resp = run_rack_3d(model, motion, dt=motion.dt / k, free_vibration=args.free_vibration,
                            basis=args.basis, save_every=args.save_every,
