@@ -30,8 +30,10 @@ _LOG = logging.getLogger(__name__)
 
 _MAX_SUBSTEPS = 512
 #: Ritz basis of a 3D rack: compression tolerance and size up to which Krylov blocks are added
-#: (tests/test_rack3d.py measures the truncation against the 2D rack on a full basis)
-PLANAR_RITZ_TOL = 3e-2
+#: (tests/test_rack3d_run.py: against the 2D rack on every mode; on the 5 x 10 warehouse rack
+#: 0.1 keeps 86 vectors, peaks within 0.5 % of 3e-2 (144 vectors) and 3.4 times faster:
+#: benchmarks/results/rack3d.md)
+PLANAR_RITZ_TOL = 1e-1
 PLANAR_RITZ_TARGET = 40
 DEFAULT_CHUNK = 5000
 _STATUS = {
