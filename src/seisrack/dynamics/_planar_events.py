@@ -110,7 +110,8 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
 
 @_JIT
 def _slide_away(lam, dirn, p):
-    """Sliding direction of a pallet released from stick: opposite to its holding force."""
+    """Direction of sliding opposite to the force ``lam`` of pallet ``p`` (its holding force
+    when released from stick, its friction force while sliding)."""
     fx = lam[2 * p]
     fz = lam[2 * p + 1]
     fn = np.sqrt(fx * fx + fz * fz)
@@ -190,12 +191,7 @@ def _track_direction(stuck, S0, dirn):
     lam = S0[3]
     for p in range(stuck.shape[0]):
         if not stuck[p]:
-            fx = lam[2 * p]
-            fz = lam[2 * p + 1]
-            fn = np.sqrt(fx * fx + fz * fz)
-            if fn > 0.0:
-                dirn[2 * p] = -fx / fn
-                dirn[2 * p + 1] = -fz / fn
+            _slide_away(lam, dirn, p)
 
 
 @_JIT

@@ -27,7 +27,9 @@ HINGE_RITZ_TOL = 1e-3
 DEFAULT_MAX_MEMORY = 4 * 2**30
 
 
-def _choose_basis(basis, M, K, sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN001, N803
+def given_or_full_basis(basis, M, K) -> Basis | None:  # noqa: ANN001, N803
+    """The caller's Basis (checked), every mode for ``"full"`` (or ``"auto"`` up to
+    ``AUTO_FULL_MAX_DOF`` DOFs), or None when a reduced basis is to be built."""
     n = M.shape[0]
     if isinstance(basis, Basis):
         if basis.phi.shape[0] != n:
@@ -37,6 +39,14 @@ def _choose_basis(basis, M, K, sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
     if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
         return full_basis(M, K)
+    return None
+
+
+def _choose_basis(basis, M, K, sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN001, N803
+    n = M.shape[0]
+    chosen = given_or_full_basis(basis, M, K)
+    if chosen is not None:
+        return chosen
     on = sliders.dof >= 0
     extra = np.zeros(n)
     np.add.at(extra, sliders.dof[on], sliders.mass[on])

@@ -19,8 +19,8 @@ from typing import NamedTuple
 import numpy as np
 
 from seisrack.dynamics import _inputs as chk
-from seisrack.dynamics._setup import AUTO_FULL_MAX_DOF, _check_memory, _kept_samples
-from seisrack.dynamics.basis import Basis, full_basis, reduced_basis
+from seisrack.dynamics._setup import _check_memory, _kept_samples, given_or_full_basis
+from seisrack.dynamics.basis import Basis, reduced_basis
 from seisrack.dynamics.engine import _blas_controller
 from seisrack.dynamics.kernels import numba_available
 from seisrack.dynamics.results import EVENT_KINDS, Event
@@ -187,14 +187,9 @@ def planar_basis(M, K, sliders: PlanarSliders, loads: np.ndarray,  # noqa: ANN00
     options of :func:`~seisrack.dynamics.basis.reduced_basis` (defaults
     ``PLANAR_RITZ_TOL``, ``PLANAR_RITZ_TARGET``)."""
     n = M.shape[0]
-    if isinstance(basis, Basis):
-        if basis.phi.shape[0] != n:
-            raise InputError("basis", f"phi of shape {basis.phi.shape}", f"phi with {n} rows")
-        return basis
-    if basis not in ("auto", "full", "reduced"):
-        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
-        return full_basis(M, K)
+    chosen = given_or_full_basis(basis, M, K)
+    if chosen is not None:
+        return chosen
     m, k = sliders.dof_x.shape
     pat = np.zeros((n, 2 * m))
     for c, dofs in enumerate((sliders.dof_x, sliders.dof_z)):
