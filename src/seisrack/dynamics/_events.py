@@ -114,6 +114,14 @@ def _bracket_open(br, T1, S1, Tb, Sb):
 
 
 @_JIT
+def _conv_limit(stuck, mus, N1, tolF):
+    """Largest violation of a located event: the hi end of the bracket ends in (tolF, this]."""
+    if stuck:
+        return 1e-10 * mus * N1 + 2.0 * tolF
+    return 2.0 * tolF
+
+
+@_JIT
 def _propose(br, stuck, e_lo, e_hi, tolF, mus, N1, hrem, dt):
     """Next trial fraction of the remaining sub-step, or -1 when the location has converged.
 
@@ -121,30 +129,78 @@ def _propose(br, stuck, e_lo, e_hi, tolF, mus, N1, hrem, dt):
     ``e_lo`` and ``e_hi`` always hold the true event values at the bracket ends; the Illinois
     weights only enter the interpolation.
     """
+    return _propose3(br, stuck, e_lo, e_hi, e_hi, -1.0, tolF, mus, N1, hrem, dt, 1e-12)
+
+
+@_JIT
+def _keep_old(br, e_try, tolF, e_lo, e_hi, e_old):
+    """Before :func:`_accept_values`: copy the bracket end the trial will replace into
+    ``e_old``; returns its fraction (the third point of :func:`_propose3`)."""
+    if _violates(e_try, tolF):
+        e_old[:] = e_hi
+        return br[1]
+    e_old[:] = e_lo
+    return br[0]
+
+
+@_JIT
+def _violates(e, tolF):
+    for j in range(e.shape[0]):
+        if e[j] > tolF[j]:
+            return True
+    return False
+
+
+@_JIT
+def _secant(a, fa, b, fb):
+    """Root of the line through two points, or -1 when their values coincide."""
+    if fa == fb:
+        return -1.0
+    return b - fb * (b - a) / (fb - fa)
+
+
+@_JIT
+def _propose3(br, stuck, e_lo, e_hi, e_old, th_old, tolF, mus, N1, hrem, dt, span_tol):
+    """:func:`_propose` with a third point: the values ``e_old`` at ``th_old`` (the bracket
+    end the last trial replaced; none when ``th_old < 0``). Each violated function's root is
+    then the secant through the third point and the bracket end on the same side of the root,
+    when it falls inside the bracket, else the Illinois estimate. The location also ends
+    when the bracket is shorter than ``span_tol`` dt."""
     theta_lo = br[0]
     theta_hi = br[1]
     th = theta_hi
     jmin = -1
     for j in range(stuck.shape[0]):
         if e_hi[j] > tolF[j]:
-            # root of e - tolF (the violation threshold), not of e: a slider that just
-            # slipped starts at e = 0 and creeps up quadratically
-            elo = min(e_lo[j] - tolF[j], 0.0) * br[2]
-            den = (e_hi[j] - tolF[j]) * br[3] - elo
+            # root of e - tgt, tgt in the middle of the acceptance window (tolF, conv] (a
+            # slider that just slipped starts at e = 0 and creeps up quadratically; aiming at
+            # the window's edge tolF landed every other trial on the wrong side)
+            tgt = tolF[j] + 0.5 * (_conv_limit(stuck[j], mus[j], N1[j], tolF[j]) - tolF[j])
+            elo = min(e_lo[j] - tgt, 0.0) * br[2]
+            den = (e_hi[j] - tgt) * br[3] - elo
             frac = -elo / den if den > 0.0 else 0.0
             tj = theta_lo + frac * (theta_hi - theta_lo)
+            if th_old >= 0.0 and br[4] < 3.0:
+                # secant through the third point and the bracket end on its side of the
+                # root: both on one smooth branch when the function has a kink at its root
+                # (a pallet that stops: sliding on one side, stopping inside the step on the
+                # other), where any interpolation across the root converges only linearly
+                fo = e_old[j] - tgt
+                if fo > 0.0:
+                    ti = _secant(theta_hi, e_hi[j] - tgt, th_old, fo)
+                else:
+                    ti = _secant(theta_lo, e_lo[j] - tgt, th_old, fo)
+                if theta_lo < ti < theta_hi:
+                    tj = ti
             if tj < th or jmin < 0:
                 th = tj
                 jmin = j
     if jmin < 0:
         return -1.0
     # convergence: the violated function is tiny at hi
-    if stuck[jmin]:
-        conv = e_hi[jmin] <= 1e-10 * mus[jmin] * N1[jmin] + tolF[jmin]
-    else:
-        conv = e_hi[jmin] <= 2.0 * tolF[jmin]
+    conv = e_hi[jmin] <= _conv_limit(stuck[jmin], mus[jmin], N1[jmin], tolF[jmin])
     span = theta_hi - theta_lo
-    if conv or span * hrem <= 1e-12 * dt:
+    if conv or span * hrem <= span_tol * dt:
         return -1.0
     if br[4] >= 6.0:  # safeguard: Illinois stalled, bisect
         th = theta_lo + 0.5 * span
@@ -169,10 +225,7 @@ def _accept_trial(br, th, stuck, sig, lam1, N_e, s1, mus, tolF, e_try, e_lo, e_h
 @_JIT
 def _accept_values(br, th, e_try, tolF, e_lo, e_hi, T1, S1, Tb, Sb):
     """:func:`_accept_trial` on event values ``e_try`` the kernel computed itself."""
-    viol = False
-    for j in range(e_try.shape[0]):
-        if e_try[j] > tolF[j]:
-            viol = True
+    viol = _violates(e_try, tolF)
     side = 1.0 if viol else -1.0
     br[4] = br[4] + 1.0 if br[5] == side else 1.0
     if viol:

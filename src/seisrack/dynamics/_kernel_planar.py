@@ -37,7 +37,8 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _bracket_end,
         _bracket_open,
         _interp,
-        _propose,
+        _keep_old,
+        _propose3,
         _substep_end,
     )
     from seisrack.dynamics._planar_events import (
@@ -59,30 +60,42 @@ STATUS_PLANAR_NEWTON = 4
 #: ever shorter times (a Zeno sequence); kept, it carries at most a round-off excess over
 #: mu_s N, or stops inside its return map, until the next step
 _CHATTER = 4
+#: an event is located when its bracket is shorter than this fraction of dt (or its event
+#: function is within its tolerance): 5e-9 s at dt = 5 ms, where a late slip onset or stop
+#: changes the state by O(span²)
+_SPAN = 1e-6
 
 
 @_JIT
 def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state, S_state,
-               stuck, dirn, S, t_offset, max_events, max_substeps,
+               stuck, dirn, S, A, fac, t_offset, max_events, max_substeps,
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
-               ev_time, ev_pallet, ev_kind):
+               ev_time, ev_pallet, ev_kind, stats):
     """Integrate ``agx.shape[0] - 1`` steps. Returns (status, n_events, n_substeps, the last
     output row written).
 
     agx, agz: (n_t,) ground accelerations down-aisle (x) and cross-aisle (z); pext: (n_t, r)
-    modal loads; N: (n_t, m) normal forces. The state (``T_state`` (3, r): q, qd, qdd;
-    ``S_state`` (6, 2m): w, wd, wdd, lam, s, vn; ``stuck``, ``dirn``, ``S``) is read when
-    ``resume`` (else the pallets start stuck on a structure at the given q, qd) and written
-    back at the end, so chunks continue exactly. Outputs per step (n_t rows): q, qd, qdd,
-    u (sliding displacement w - P q), v (relative velocity), lam (friction force on the
-    pallet), stuck.
+    modal loads; N: (n_t, m) normal forces. The state is read when ``resume`` (else the
+    pallets start stuck on a structure at the given q, qd) and written back at the end, so
+    chunks continue exactly: ``T_state`` (3, r): q, qd, qdd; ``S_state`` (6, 2m): w, wd, wdd,
+    lam, s, vn; ``stuck``, ``dirn``; ``S`` (r + 2, r): the stuck pallets' mass (see
+    ``_s_update``); ``A`` (r, r) and ``fac`` (1,): the last factorised Newton matrix and its
+    step length, -1 for none (see ``_trial``). ``stats`` (int64, 4) accumulates the trial
+    steps, Newton iterations, Cholesky factorisations and location trials. Outputs per step
+    (n_t rows): q, qd, qdd, u (sliding displacement w - P q), v (relative velocity), lam
+    (friction force on the pallet), stuck.
     """
     r = kd.shape[0]
     m = mass.shape[0]
     n_t = agx.shape[0]
     nw = max(r, 2 * m, 1)
-    W = np.empty((9, nw))
-    A = np.empty((r, r))
+    W = np.empty((12, nw))
+    G = np.empty((2 * m, r))
+    PF = np.empty((2 * m, r))
+    dqa = np.empty(r)  # the last two trials of a location (fractions tha, thb): the next
+    dqb = np.empty(r)  # trial starts from their quadratic interpolation through dq(0) = 0
+    dqg = np.empty(r)
+    qdd_full = np.empty(r)
     T0 = T_state.copy()
     S0 = S_state.copy()
     T1 = np.empty_like(T0)
@@ -92,6 +105,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     e_lo = np.empty(m)
     e_hi = np.empty(m)
     e_try = np.empty(m)
+    e_old = np.empty(m)
     tolF = np.empty(m)
     tolT = np.empty(m)
     c_full = np.empty(m)
@@ -148,8 +162,11 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 N0[p] = _interp(N[k, p], N[k + 1, p], tau)
             ag[0] = agx[k + 1]
             ag[1] = agz[k + 1]
+            for i in range(r):
+                dqg[i] = hrem * T0[1, i] + 0.5 * hrem * hrem * T0[2, i]
             ok = _trial(hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag,
-                        pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A)
+                        pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF, stats,
+                        dqg, True, fac)
             _mask_frozen(frozen, e_hi)
             if ok != 0:
                 status = STATUS_PLANAR_NEWTON + ok - 1
@@ -162,8 +179,15 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
             if any_ev:
                 _start_values(stuck, mus, N0, S0, e_lo)
                 _bracket_open(br, T1, S1, Tb, Sb)
+                tha = 1.0
+                thb = -1.0
+                th_old = -1.0
+                for i in range(r):
+                    dqa[i] = T1[0, i] - T0[0, i]
+                    qdd_full[i] = T1[2, i]
                 for _loc in range(200):
-                    th = _propose(br, stuck, e_lo, e_hi, tolF, mus, N[k + 1], hrem, dt)
+                    th = _propose3(br, stuck, e_lo, e_hi, e_old, th_old, tolF, mus, N[k + 1],
+                                   hrem, dt, _SPAN)
                     if th < 0.0:
                         break
                     frac = tau + th * (1.0 - tau)
@@ -172,12 +196,34 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                     _sample_row(pext, k, frac, pe)
                     for p in range(m):
                         Ne[p] = _interp(N[k, p], N[k + 1, p], frac)
+                    stats[3] += 1
+                    warm = True
+                    if thb > 0.0:
+                        # quadratic through dq(0) = 0 and the last two trials
+                        la = th * (th - thb) / (tha * (tha - thb))
+                        lb = th * (th - tha) / (thb * (thb - tha))
+                        for i in range(r):
+                            dqg[i] = la * dqa[i] + lb * dqb[i]
+                    else:
+                        # Newmark's dq with the end acceleration linear between the start and
+                        # the end of the full trial
+                        hs = th * hrem
+                        for i in range(r):
+                            dqg[i] = hs * T0[1, i] + 0.25 * hs * hs * (
+                                2.0 * T0[2, i] + th * (qdd_full[i] - T0[2, i]))
                     ok = _trial(th * hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck,
-                                dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A)
+                                dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G, PF, stats,
+                                dqg, warm, fac)
+                    dqb[:] = dqa
+                    thb = tha
+                    tha = th
+                    for i in range(r):
+                        dqa[i] = T1[0, i] - T0[0, i]
                     _mask_frozen(frozen, e_try)
                     if ok != 0:
                         status = STATUS_PLANAR_NEWTON + ok - 1
                         break
+                    th_old = _keep_old(br, e_try, tolF, e_lo, e_hi, e_old)
                     _accept_values(br, th, e_try, tolF, e_lo, e_hi, T1, S1, Tb, Sb)
                 if status != STATUS_OK:
                     break
@@ -197,7 +243,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
                 _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pe, Ne, stuck, dirn,
-                        cand, forced, A, W[7, :r], frozen)
+                        cand, forced, A, W[11, :r], frozen)
+                fac[0] = -1.0
                 for p in range(m):
                     # a pallet that reached zero velocity and slides on has turned
                     turned[p] = cand[p] and not stuck[p] and not old_stuck[p]

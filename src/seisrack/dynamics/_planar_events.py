@@ -12,6 +12,7 @@ try:  # names injected by the loader when executed after ``_planar_step.py``
     _chol  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, KIND_REVERSE, KIND_SLIP, KIND_STICK
+    from seisrack.dynamics._planar_contact import _released_forces
     from seisrack.dynamics._planar_step import _chol, _chol_solve, _s_update
 
 @_JIT
@@ -48,39 +49,65 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
         if cand[p] and not stuck[p]:
             stuck[p] = True
             _s_update(S, P, mass, p, 1.0)
-    for _it in range(2 * m + 2):
+    zr = np.zeros(m, dtype=np.bool_)  # released here: sliding from zero relative velocity
+    fv = np.empty(2 * m)
+    for _it in range(4 * m + 4):
         # (I + S) qdd = pext - C qd - K q - sum_F P_pᵀ lam_p - sum_S m_p P_pᵀ ag
-        for i in range(r):
-            base[i] = pext[i] - cd[i] * qd[i] - kd[i] * q[i]
-        for p in range(m):
-            for c in range(2):
-                j = 2 * p + c
-                if stuck[p]:
-                    f = mass[p] * ag[c]
-                else:
-                    f = -mud[p] * N[p] * dirn[j]
-                    lam[j] = f
-                for i in range(r):
-                    base[i] -= P[j, i] * f
         for i in range(r):
             for k in range(r):
                 A[i, k] = S[i, k]
             A[i, i] += 1.0
         _chol(A)
+        n_rel = 0
+        for p in range(m):
+            if zr[p] and not stuck[p]:
+                n_rel += 1
+            for c in range(2):
+                j = 2 * p + c
+                if stuck[p]:
+                    fv[j] = mass[p] * ag[c]
+                elif zr[p]:
+                    fv[j] = 0.0  # from the contact problem below
+                else:
+                    fv[j] = -mud[p] * N[p] * dirn[j]
+                    lam[j] = fv[j]
+        base[:] = pext - cd * qd - kd * q - np.dot(fv, P)
         _chol_solve(A, base)
+        if n_rel > 0:
+            rel = np.empty(n_rel, dtype=np.int64)
+            a = 0
+            for p in range(m):
+                if zr[p] and not stuck[p]:
+                    rel[a] = p
+                    a += 1
+            inside = np.zeros(n_rel, dtype=np.bool_)
+            _released_forces(A, P, mass, mud, N, ag, base, rel, lam, inside)
+            restick = False
+            for a in range(n_rel):
+                p = rel[a]
+                if inside[a]:
+                    # holds with less than mu_d N once the others slide: it sticks (and is
+                    # released again only beyond mu_s N)
+                    stuck[p] = True
+                    zr[p] = False
+                    forced[p] = False
+                    _s_update(S, P, mass, p, 1.0)
+                    restick = True
+                else:
+                    _slide_away(lam, dirn, p)
+            if restick:
+                continue
         for i in range(r):
             qdd[i] = base[i]
         worst = -1
         worst_ratio = 1.0 + 1e-12
+        pa = np.dot(P, qdd)
         for p in range(m):
             if not stuck[p]:
                 continue
             for c in range(2):
                 j = 2 * p + c
-                acc = 0.0
-                for i in range(r):
-                    acc += P[j, i] * qdd[i]
-                lam[j] = mass[p] * (acc + ag[c])
+                lam[j] = mass[p] * (pa[j] + ag[c])
             mag = np.sqrt(lam[2 * p] ** 2 + lam[2 * p + 1] ** 2)
             cap = mus[p] * N[p]
             ratio = mag / cap if cap > 0.0 else (np.inf if mag > 0.0 else 0.0)
@@ -94,16 +121,15 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
         if worst < 0:
             break
         stuck[worst] = False
+        zr[worst] = True
         _s_update(S, P, mass, worst, -1.0)
         _slide_away(lam, dirn, worst)
+    pa = np.dot(P, qdd)
     for p in range(m):
         for c in range(2):
             j = 2 * p + c
             if stuck[p]:
-                acc = 0.0
-                for i in range(r):
-                    acc += P[j, i] * qdd[i]
-                wdd[j] = acc
+                wdd[j] = pa[j]
             else:
                 wdd[j] = -ag[c] + lam[j] / mass[p]
 
@@ -197,14 +223,10 @@ def _track_direction(stuck, S0, dirn):
 @_JIT
 def _fill_relative(P, T0, S0):
     """Support velocity ``vn`` and relative velocity ``s`` of the state (after a transition)."""
-    qd = T0[1]
     wd, s, vn = S0[1], S0[4], S0[5]
+    vn[:] = np.dot(P, T0[1])
     for j in range(P.shape[0]):
-        acc = 0.0
-        for i in range(P.shape[1]):
-            acc += P[j, i] * qd[i]
-        vn[j] = acc
-        s[j] = wd[j] - acc
+        s[j] = wd[j] - vn[j]
 
 
 @_JIT
@@ -212,13 +234,7 @@ def _output(k, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, 
     out_q[k, :] = T0[0]
     out_qd[k, :] = T0[1]
     out_qdd[k, :] = T0[2]
-    q = T0[0]
-    w = S0[0]
-    for j in range(P.shape[0]):
-        acc = 0.0
-        for i in range(P.shape[1]):
-            acc += P[j, i] * q[i]
-        out_u[k, j] = w[j] - acc
+    out_u[k, :] = S0[0] - np.dot(P, T0[0])
     out_v[k, :] = S0[4]
     out_lam[k, :] = S0[3]
     for p in range(stuck.shape[0]):

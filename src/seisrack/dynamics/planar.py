@@ -140,6 +140,8 @@ class PlanarHistory:
     q, qd, qdd: (n_t, r) basis coordinates (``u = q @ phi.T``); sliding, velocity, friction:
     (n_t, m, 2) pallet sliding displacement [m], velocity [m/s] relative to its supports and
     friction force on it [N], components (x, z); normal (n_t, m) [N]; stuck (n_t, m).
+    ``work``: the solver's effort (trial steps, Newton iterations, Cholesky factorisations,
+    trials spent locating events).
     """
 
     t: np.ndarray
@@ -158,6 +160,7 @@ class PlanarHistory:
     backend: str = "python"
     n_substeps: int = 0
     basis: dict = field(default_factory=dict)
+    work: dict = field(default_factory=dict)
 
     def dof_response(self, dofs: np.ndarray, kind: str = "u") -> np.ndarray:
         """(n_t, len(dofs)) displacement ("u"), velocity ("v") or acceleration ("a")."""
@@ -301,7 +304,9 @@ def simulate_planar(
     S_state = np.zeros((6, 2 * m))
     stuck = np.ones(m, dtype=np.bool_)
     dirn = np.zeros(2 * m)
-    S = np.zeros((nb, nb))
+    S = np.zeros((nb + 2, nb))  # the stuck pallets' mass and first moments (_s_update)
+    A = np.zeros((nb, nb))  # the last factorised Newton matrix, kept across chunks
+    fac = np.full(1, -1.0)  # its step length (-1: none)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
@@ -312,6 +317,7 @@ def simulate_planar(
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     kept_N = np.empty((keep_idx.size, m))
     status, n_ev, n_sub, start = 0, 0, 0, 0
+    stats = np.zeros(4, dtype=np.int64)
     limiter = _blas_controller().limit(limits=1, user_api="blas")
     try:
         while start < n_steps:
@@ -325,8 +331,8 @@ def simulate_planar(
             st, ne, ns, kd_done = mod.run_planar(
                 kd, cd, P, mass, mus, mud, float(dt), np.ascontiguousarray(agx[rows]),
                 np.ascontiguousarray(agz[rows]), pext, N, start > 0, T_state, S_state,
-                stuck, dirn, S, start * float(dt), left, _MAX_SUBSTEPS, *outs,
-                ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:])
+                stuck, dirn, S, A, fac, start * float(dt), left, _MAX_SUBSTEPS, *outs,
+                ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:], stats)
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
@@ -366,7 +372,9 @@ def simulate_planar(
         t=keep_idx * dt, q=kq, qd=kqd, qdd=kqdd, phi=phi, sliding=ku.reshape(-1, m, 2),
         velocity=kv.reshape(-1, m, 2), friction=kl.reshape(-1, m, 2), normal=kept_N,
         stuck=ks, events=events, sample_index=keep_idx, status=status_text, backend=used,
-        n_substeps=n_sub, basis=bas.describe())
+        n_substeps=n_sub, basis=bas.describe(),
+        work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
+                      (int(x) for x in stats), strict=True)))
 
 
 def _keep_index(n_steps: int, save_every: int | None) -> np.ndarray:
