@@ -39,11 +39,12 @@ def _chol_solve(L, x):
         for k in range(i):
             acc -= L[i, k] * x[k]
         x[i] = acc / L[i, i]
+    # Lᵀ y = x by columns of Lᵀ, i.e. rows of L (contiguous)
     for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for k in range(i + 1, n):
-            acc -= L[k, i] * x[k]
-        x[i] = acc / L[i, i]
+        xi = x[i] / L[i, i]
+        x[i] = xi
+        for k in range(i):
+            x[k] -= L[i, k] * xi
 
 
 @_JIT
@@ -277,7 +278,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
             break
         # the next iteration keeps this factor (a chord step) while the full steps are small
         # or contract fast: the Jacobian only moves with the sliding directions
-        refac = not (alpha == 1.0 and ((last < 1e300 and step <= 0.05 * last)
+        refac = not (alpha == 1.0 and ((last < 1e300 and step <= 0.2 * last)
                                        or (_it == 0 and step <= 1e-6 * ymax)))
         last = step if alpha == 1.0 else 1e300
     if n_slide > 0:
