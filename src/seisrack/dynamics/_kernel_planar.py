@@ -89,7 +89,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     m = mass.shape[0]
     n_t = agx.shape[0]
     nw = max(r, 2 * m, 1)
-    W = np.empty((12, nw))
+    W = np.empty((11, nw))
     G = np.empty((2 * m, r))
     PF = np.empty((2 * m, r))
     dqa = np.empty(r)  # the last two trials of a location (fractions tha, thb): the next
@@ -243,7 +243,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
                 _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pe, Ne, stuck, dirn,
-                        cand, forced, A, W[11, :r], frozen)
+                        cand, forced, A, W[10, :r], frozen)
                 fac[0] = -1.0
                 for p in range(m):
                     # a pallet that reached zero velocity and slides on has turned

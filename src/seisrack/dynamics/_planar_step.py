@@ -138,7 +138,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
 
     T rows: q, qd, qdd (r); S rows: w, wd, wdd, lam, s (relative velocity), vn (support
     velocity) (2m). Writes the event values ``e`` (positive when the state is violated) and
-    their thresholds ``tolF``. ``W`` (12, max(r, 2m)), ``G`` and ``PF`` (2m, r) are scratch
+    their thresholds ``tolF``. ``W`` (10, max(r, 2m)), ``G`` and ``PF`` (2m, r) are scratch
     (``PF``: the sliding pallets' rows of ``P``, so that the products inside Newton's
     iteration skip the stuck pallets); ``stats`` counts trials, Newton iterations and
     factorisations. ``warm``: Newton starts from ``dq_start`` (a prediction from nearby
