@@ -45,6 +45,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _classify,
         _decide,
         _fill_relative,
+        _first_guess,
         _mask_frozen,
         _output,
         _record,
@@ -115,6 +116,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     turned = np.zeros(m, dtype=np.bool_)
     old_stuck = stuck.copy()
     ag = np.empty(2)
+    ag0 = np.empty(2)
     pe = np.empty(r)
     Ne = np.empty(m)
     N0 = np.empty(m)
@@ -178,6 +180,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
             th_hi = 1.0
             if any_ev:
                 _start_values(stuck, mus, N0, S0, e_lo)
+                ag0[0] = _interp(agx[k], agx[k + 1], tau)
+                ag0[1] = _interp(agz[k], agz[k + 1], tau)
                 _bracket_open(br, T1, S1, Tb, Sb)
                 tha = 1.0
                 thb = -1.0
@@ -190,6 +194,9 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                                    hrem, dt, _SPAN)
                     if th < 0.0:
                         break
+                    if _loc == 0:
+                        th = _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P,
+                                          T0[2], ag0, hrem)
                     frac = tau + th * (1.0 - tau)
                     ag[0] = _interp(agx[k], agx[k + 1], frac)
                     ag[1] = _interp(agz[k], agz[k + 1], frac)

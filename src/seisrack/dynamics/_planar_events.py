@@ -13,7 +13,8 @@ try:  # names injected by the loader when executed after ``_planar_step.py``
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, KIND_REVERSE, KIND_SLIP, KIND_STICK
     from seisrack.dynamics._planar_contact import _released_forces
-    from seisrack.dynamics._planar_step import _chol, _chol_solve, _s_update
+    from seisrack.dynamics._planar_lapack import _chol
+    from seisrack.dynamics._planar_step import _chol_solve, _s_update
 
 @_JIT
 def _start_values(stuck, mus, N0, S0, e_lo):
@@ -25,6 +26,39 @@ def _start_values(stuck, mus, N0, S0, e_lo):
             e_lo[p] = np.sqrt(lam[jx] ** 2 + lam[jx + 1] ** 2) - mus[p] * N0[p]
         else:
             e_lo[p] = -np.sqrt(s[jx] ** 2 + s[jx + 1] ** 2)
+
+
+@_JIT
+def _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P, qdd0, ag0, hrem):
+    """First trial fraction of an event location (bracket [0, 1]): the earliest root of the
+    violated event functions. A sliding pallet's is the root of the quadratic through its value
+    and slope at the start and its value at the end: its stop function c - d0·z rises at the
+    start at hrem (mu_d N / m + d0·(ag + P qdd)), its deceleration relative to its support, and
+    curves with the structure's response over the step, which a straight line through the two
+    ends (Illinois' first estimate) often misses by a factor of two. A stuck pallet's is that
+    straight line."""
+    th = 2.0
+    for p in range(stuck.shape[0]):
+        if e_hi[p] <= tolF[p]:
+            continue
+        tgt = 1.5 * tolF[p]  # the middle of the acceptance window (tolF, 2 tolF]
+        f0 = min(e_lo[p] - tgt, 0.0)
+        f1 = e_hi[p] - tgt
+        tj = -f0 / (f1 - f0)
+        if not stuck[p]:
+            jx = 2 * p
+            d = mud[p] * N0[p] / mass[p]
+            for c in range(2):
+                d += dirn[jx + c] * (ag0[c] + np.dot(P[jx + c], qdd0))
+            d *= hrem
+            a = f1 - f0 - d
+            disc = d * d - 4.0 * a * f0
+            if d > 0.0 and disc >= 0.0:
+                tq = -2.0 * f0 / (d + np.sqrt(disc))
+                if 0.0 < tq < 1.0:
+                    tj = tq
+        th = min(th, tj)
+    return min(max(th, 1e-6), 1.0 - 1e-6)
 
 
 @_JIT
@@ -54,7 +88,7 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
     for _it in range(4 * m + 4):
         # (I + S) qdd = pext - C qd - K q - sum_F P_pᵀ lam_p - sum_S m_p P_pᵀ ag
         for i in range(r):
-            for k in range(r):
+            for k in range(i + 1):
                 A[i, k] = S[i, k]
             A[i, i] += 1.0
         _chol(A)

@@ -14,20 +14,9 @@ try:  # names injected by the loader when executed after ``_events.py``
     _interp  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, _interp
+    from seisrack.dynamics._planar_lapack import _chol, _syrk_lower
 
 _NEWTON_MAX = 40
-
-
-@_JIT
-def _chol(a):
-    """Lower Cholesky factor of the SPD matrix ``a`` into ``a`` (LAPACK); False if not
-    positive definite."""
-    try:
-        L = np.linalg.cholesky(a)
-    except Exception:  # noqa: BLE001  (numba raises LinAlgError; status codes, not raises)
-        return False
-    a[:, :] = L
-    return True
 
 
 @_JIT
@@ -73,10 +62,11 @@ def _sample_row(X, step, frac, out):
 
 @_JIT
 def _a_lin(A, S, c0, c2, cd, kd):
-    """A = diag(c0 + c2 cd + kd) + c0 S: the step's stiffness with the stuck pallets."""
+    """A = diag(c0 + c2 cd + kd) + c0 S: the step's stiffness with the stuck pallets (its
+    lower triangle, all that :func:`_chol` reads)."""
     r = kd.shape[0]
     for i in range(r):
-        for k in range(r):
+        for k in range(i + 1):
             A[i, k] = c0 * S[i, k]
         A[i, i] += c0 + c2 * cd[i] + kd[i]
 
@@ -212,9 +202,11 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     # y_p = zf_p - c2 P_p dq. R is minus the gradient of a strictly convex potential (the
     # friction term is a Huber function of y_p): Newton's steps are damped by backtracking on
     # it, which cures the cycling of plain Newton across the disc
+    sd = np.empty(r)  # S dq, and pd = PF dq: updated with the steps of dq
     for _it in range(_NEWTON_MAX if n_slide > 0 else 0):
-        pd[:] = np.dot(PFs, dq)
-        sd = np.dot(Ss, dq)
+        if _it == 0:
+            pd[:] = np.dot(PFs, dq)
+            sd[:] = np.dot(Ss, dq)
         for i in range(r):
             rlin[i] = rhs[i] - dg[i] * dq[i] - c0 * sd[i]
         ymax = 0.0
@@ -232,9 +224,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         res[:] = rlin - np.dot(lam, PFs)
         if refac:
             _a_lin(A, S, c0, c2, cd, kd)
-            if ng > 0:
-                Gs = G[:ng]
-                A += np.dot(Gs.T, Gs)
+            _syrk_lower(A, G, ng)
             stats[2] += 1
             if not _chol(A):
                 return 1
@@ -267,7 +257,9 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         step = 0.0
         for i in range(r):
             dq[i] += alpha * stp[i]
+            sd[i] += alpha * ss[i]
         for jf in range(nf):
+            pd[jf] += alpha * ps[jf]
             step = max(step, abs(c2 * alpha * ps[jf]))
         # converged when this step, or the next one estimated from the contraction of the
         # last two full steps (Newton's is superlinear), is below 1e-12 (1e-11) of the scale
@@ -279,10 +271,9 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         # the next iteration keeps this factor (a chord step) while the full steps are small
         # or contract fast: the Jacobian only moves with the sliding directions
         refac = not (alpha == 1.0 and ((last < 1e300 and step <= 0.2 * last)
-                                       or (_it == 0 and step <= 1e-6 * ymax)))
+                                       or _it == 0))
         last = step if alpha == 1.0 else 1e300
     if n_slide > 0:
-        pd[:] = np.dot(PFs, dq)
         for a in range(n_slide):
             jx = 2 * a
             _friction(a, sl[a], h, c2, PFs, mass, mud, N1, zf[jx] - c2 * pd[jx],
