@@ -104,6 +104,16 @@ def test_three_per_bay():
         [c + 0.25, 2 * c + 0.75, 3 * c + 1.25])
 
 
+def test_four_eur_pallets_in_a_3_6_m_bay():
+    d = table_dict(pallets_per_bay=4)
+    d["geometry"]["bays"] = {"count": 2, "pitch": 3.6}
+    spec = rack_from_dict(d)
+    assert len(spec.pallets) == 4 * 2 * 3
+    c = (3.6 - 4 * 0.8) / 5  # 80 mm clearances
+    assert [p.position for p in spec.pallets[:4]] == pytest.approx(
+        [c + 0.4, 2 * c + 1.2, 3 * c + 2.0, 4 * c + 2.8])
+
+
 def test_gap_centres_the_group():
     spec = rack_from_dict(table_dict(width=0.6, gap=0.1))
     left, right = spec.pallets[0], spec.pallets[1]
@@ -233,8 +243,9 @@ BAD_LOADING = [
      "loading.mass_per_level", "not both"),
     ("no-mass", table_dict(mass=None), "loading.mass", "mass_per_level"),
     ("zero-mass", table_dict(mass=0.0), "loading.mass", "> 0"),
-    ("ppb-zero", table_dict(pallets_per_bay=0), "loading.pallets_per_bay", "1 to 3"),
-    ("ppb-four", table_dict(pallets_per_bay=4, width=0.4), "loading.pallets_per_bay", "1 to 3"),
+    ("ppb-zero", table_dict(pallets_per_bay=0), "loading.pallets_per_bay", "1 to 6"),
+    ("ppb-seven", table_dict(pallets_per_bay=7, width=0.2), "loading.pallets_per_bay", "1 to 6"),
+    ("four-eur-in-1.8", table_dict(pallets_per_bay=4), "loading.width", "3.2"),
     ("ppb-float", table_dict(pallets_per_bay=2.0), "loading.pallets_per_bay", "integer"),
     ("mu-dynamic-above-static", table_dict(mu_dynamic=0.5), "loading.mu_dynamic", "<= "),
     ("mu-missing", _without(table_dict(), "mu_static"), "loading.mu_static", "required"),

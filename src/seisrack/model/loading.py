@@ -27,8 +27,10 @@ import numpy as np
 from seisrack.model._reader import Table, check_friction, check_number
 from seisrack.model.spec import DEFAULT_PALLET_WIDTH, Geometry, Pallet
 
-#: Most pallets a bay can hold side by side in the table (three EUR pallets fill a 2.7 m bay).
-MAX_PALLETS_PER_BAY = 3
+#: Most pallets the table places side by side in one bay: three EUR pallets fill a 2.7 m bay,
+#: four a 3.6 m one and five a 4.5 m long-span bay; six leaves room for narrow pallets. Whether
+#: they fit is checked against each bay's span.
+MAX_PALLETS_PER_BAY = 6
 #: Keys of the ``[loading]`` table.
 LOADING_KEYS = ("pallets_per_bay", "width", "gap", "mass", "mass_per_level", "mu_static",
                 "mu_dynamic", "occupancy", "seed", "levels", "sliding_limit", "friction_rate")
