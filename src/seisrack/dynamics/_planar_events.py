@@ -41,7 +41,9 @@ def _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P, qdd0, ag0, hre
     for p in range(stuck.shape[0]):
         if e_hi[p] <= tolF[p]:
             continue
-        tgt = 1.5 * tolF[p]  # the middle of the acceptance window (tolF, 2 tolF]
+        # the middle of a sliding pallet's acceptance window (tolF, 2 tolF]; a stuck one's
+        # (_conv_limit) is 5e-11 mu_s N higher, immaterial for a first trial
+        tgt = 1.5 * tolF[p]
         f0 = min(e_lo[p] - tgt, 0.0)
         f1 = e_hi[p] - tgt
         tj = -f0 / (f1 - f0)
