@@ -74,7 +74,7 @@ def test_sdof_bad_input_subprocess_no_traceback():
 
 
 def test_validate_json_shape(capsys, monkeypatch):
-    import seisrack.validation.examples as exm
+    import seisrack.paper.examples as exm
 
     calls = {}
 

@@ -22,7 +22,7 @@ import json
 import numpy as np
 import pytest
 
-import seisrack.validation.examples as exm
+import seisrack.paper.examples as exm
 from seisrack.cli import main
 from seisrack.dynamics import Sliders, simulate
 

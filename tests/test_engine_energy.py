@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from seisrack.dynamics import Sliders, simulate
-from seisrack.validation.examples import example2, example3
+from seisrack.paper.examples import example2, example3
 
 G = 9.81
 DT = 1e-3

@@ -1,7 +1,7 @@
 """Validation examples 2 and 3: production engine vs the event-driven reference (issue #3).
 
 Source: the paper's §III.B validation examples, with the exact definitions of issue #3 (the
-paper's figures are lost): ``seisrack.validation.examples``. The reference is the independent
+paper's figures are lost): ``seisrack.paper.examples``. The reference is the independent
 semi-analytical solver ``seisrack.dynamics.reference.simulate_reference`` (exact switching
 times, DOP853 at rtol 1e-11 inside the phases). Acceptance of issue #3, verbatim: at dt = 1 ms
 the peaks of every structural displacement and of the relative sliding agree within 0.5 %, and
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from seisrack.dynamics import simulate
-from seisrack.validation.examples import (
+from seisrack.paper.examples import (
     example2,
     example3,
     examples,

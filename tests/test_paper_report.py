@@ -14,7 +14,7 @@ import json
 import pytest
 
 from seisrack.cli import main
-from seisrack.report import paper_values as pv
+from seisrack.paper import values as pv
 
 FIGURES = (
     "fig05_sdof_phases.png", "fig06_regime_map.png", "fig07_sdof_cases.png",

@@ -6,7 +6,7 @@ engine comparison belongs to the engine's own tests.
 
 from __future__ import annotations
 
-from seisrack.validation.examples import example2, example3, run_validation
+from seisrack.paper.examples import example2, example3, run_validation
 
 
 def test_example_data_shapes():

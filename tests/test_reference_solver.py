@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 
 from seisrack.dynamics.reference import simulate_reference
 from seisrack.errors import InputError
+from seisrack.paper.examples import example2, example3, run_reference
 from seisrack.sdof.closed_form import solve_sdof
-from seisrack.validation.examples import example2, example3, run_reference
 
 G = 9.81
 

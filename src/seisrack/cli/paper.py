@@ -30,7 +30,7 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
-    from seisrack.report.paper import reproduce_paper
+    from seisrack.paper.reproduce import reproduce_paper
 
     t0 = time.perf_counter()
 

@@ -37,7 +37,7 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from seisrack.validation.examples import run_validation
+    from seisrack.paper.examples import run_validation
 
     if not (math.isfinite(args.dt) and args.dt > 0):
         raise InputError("dt", args.dt, "a finite number > 0")
@@ -46,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
         dt=args.dt, engine=None if args.reference_only else "auto", keep_histories=plot
     )
     if plot:
-        from seisrack.report.validation_plot import save_validation_figures
+        from seisrack.paper.validation_plot import save_validation_figures
 
         save_validation_figures(res, Path(args.plot))
     clean = {

@@ -3,7 +3,7 @@
 :func:`write_html_report` writes ONE self-contained file: inline CSS, figures as base64 PNG
 (matplotlib) and, when plotly is installed, interactive time histories with plotly's JavaScript
 bundled in the file (static figures otherwise). It opens offline and prints on A4. This is the
-engineer's report, apart from the paper's reproduction (``seisrack.report.paper*``).
+engineer's report, apart from the paper's reproduction (``seisrack.paper``).
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from seisrack.report import paper_values as pv
-from seisrack.report.paper_types import Check, Figure, Section, md_table, pyplot
+from seisrack.paper import values as pv
+from seisrack.paper.sections import Check, Figure, Section, md_table, pyplot
 from seisrack.sdof.closed_form import SdofSolution, solve_sdof
 from seisrack.sdof.regime import (
     continuous_sliding_threshold,

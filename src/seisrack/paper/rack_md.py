@@ -6,11 +6,11 @@ import time
 from pathlib import Path
 from typing import Any
 
-from seisrack.report import paper_values as pv
-from seisrack.report.paper_checks import rack_checks, simplified_rows
-from seisrack.report.paper_rack import run_rack_study, study_summary
-from seisrack.report.paper_rack_plot import save_fig15, save_fig16, save_physics_figure
-from seisrack.report.paper_types import Figure, Section, md_table
+from seisrack.paper import values as pv
+from seisrack.paper.checks import rack_checks, simplified_rows
+from seisrack.paper.rack import run_rack_study, study_summary
+from seisrack.paper.rack_plot import save_fig15, save_fig16, save_physics_figure
+from seisrack.paper.sections import Figure, Section, md_table
 
 __all__ = ["markdown_rack", "run_rack_section"]
 

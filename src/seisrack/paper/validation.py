@@ -18,8 +18,8 @@ import numpy as np
 
 from seisrack.dynamics import simulate
 from seisrack.dynamics.reference import simulate_reference
-from seisrack.report.paper_types import Check, Figure, Section, md_table, pyplot
-from seisrack.validation.examples import ValidationExample, examples, run_engine
+from seisrack.paper.examples import ValidationExample, examples, run_engine
+from seisrack.paper.sections import Check, Figure, Section, md_table, pyplot
 
 __all__ = ["markdown_validation", "run_validation_section"]
 

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from seisrack.motion.records import G as G_REC
-from seisrack.report import paper_values as pv
-from seisrack.report.paper_rack import RackRun, RackStudy, table_row
-from seisrack.report.paper_types import pyplot
+from seisrack.paper import values as pv
+from seisrack.paper.rack import RackRun, RackStudy, table_row
+from seisrack.paper.sections import pyplot
 
 __all__ = ["save_fig15", "save_fig16", "save_physics_figure"]
 

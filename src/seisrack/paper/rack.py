@@ -5,8 +5,8 @@ the paper's Table 2 implies (its forces are exactly μ·1600·10 N). The ground 
 synthetic EC8 Type 1, ground C, 0.3 g, 15 s accelerogram with a fixed seed: the paper's GOSCA
 record cannot be recovered, so the physics is reproduced, not the digits.
 
-Figures are in :mod:`seisrack.report.paper_rack_plot`, checks in
-:mod:`seisrack.report.paper_checks`, Markdown in :mod:`seisrack.report.paper_rack_md`.
+Figures are in :mod:`seisrack.paper.rack_plot`, checks in
+:mod:`seisrack.paper.checks`, Markdown in :mod:`seisrack.paper.rack_md`.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from seisrack.motion import (
     generate_ec8_record,
     response_spectrum,
 )
-from seisrack.report import paper_values as pv
+from seisrack.paper import values as pv
 
 __all__ = [
     "RackRun", "RackStudy", "find_paper_rack", "make_record", "run_rack_study", "study_summary",

@@ -5,11 +5,11 @@ subjected to earthquake" (Université de Liège, Seisracks project RFCS-PR-03114
 report (``report.md``) into one directory:
 
 - §II, the sliding block on a sinusoidal support (Figs 5–7, the 0.537 threshold):
-  :mod:`seisrack.report.paper_sdof`;
+  :mod:`seisrack.paper.sdof`;
 - §III.B, validation examples 2 and 3, engine against the event-driven reference (Figs 11b, 12b):
-  :mod:`seisrack.report.paper_validation`;
+  :mod:`seisrack.paper.validation`;
 - §IV, the paper's rack under an EC8 accelerogram (modal result, Fig. 15, Table 2, Fig. 16, a
-  7-record suite, the simplified check, and the physics checks): :mod:`seisrack.report.paper_rack`
+  7-record suite, the simplified check, and the physics checks): :mod:`seisrack.paper.rack`
   and its companions.
 
 The paper's accelerogram cannot be recovered, so §IV reproduces the physics, not the digits, and
@@ -30,8 +30,8 @@ from pathlib import Path
 from typing import Any
 
 from seisrack import __version__
-from seisrack.report import paper_values as pv
-from seisrack.report.paper_types import Section, md_table
+from seisrack.paper import values as pv
+from seisrack.paper.sections import Section, md_table
 
 __all__ = ["PaperReport", "reproduce_paper"]
 
@@ -118,9 +118,9 @@ def _header(rep: PaperReport) -> str:
 
 
 def _section_md(sec: Section) -> str:
-    from seisrack.report.paper_rack_md import markdown_rack
-    from seisrack.report.paper_sdof import markdown_sdof
-    from seisrack.report.paper_validation import markdown_validation
+    from seisrack.paper.rack_md import markdown_rack
+    from seisrack.paper.sdof import markdown_sdof
+    from seisrack.paper.validation import markdown_validation
 
     body = {"sdof": markdown_sdof, "validation": markdown_validation,
             "rack": markdown_rack}[sec.key](sec)
@@ -157,10 +157,10 @@ def reproduce_paper(
     ``examples/paper_rack.toml``). executor: runs §II and §III concurrently if given.
     progress: called with (section title, seconds) as each section finishes.
     """
-    from seisrack.report.paper_rack import SEED, make_record, suite_size
-    from seisrack.report.paper_rack_md import run_rack_section
-    from seisrack.report.paper_sdof import run_sdof
-    from seisrack.report.paper_validation import run_validation_section
+    from seisrack.paper.rack import SEED, make_record, suite_size
+    from seisrack.paper.rack_md import run_rack_section
+    from seisrack.paper.sdof import run_sdof
+    from seisrack.paper.validation import run_validation_section
 
     t_all = time.perf_counter()
     out = Path(out_dir)

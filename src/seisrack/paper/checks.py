@@ -1,6 +1,6 @@
 """The physics the paper's §IV reports, checked on our runs (the digits cannot be reproduced).
 
-Each function returns a :class:`~seisrack.report.paper_types.Check` with the numbers found:
+Each function returns a :class:`~seisrack.paper.sections.Check` with the numbers found:
 
 - the modal result (T1, participation) against the paper's 0.65 s and 99.6 %;
 - the total contact force is capped at μ·M·g when the pallets slide;
@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from seisrack.report import paper_values as pv
-from seisrack.report.paper_rack import RackRun, RackStudy, table_row
-from seisrack.report.paper_types import Check
+from seisrack.paper import values as pv
+from seisrack.paper.rack import RackRun, RackStudy, table_row
+from seisrack.paper.sections import Check
 
 __all__ = ["proportionality", "rack_checks"]
 

@@ -1,1 +1,0 @@
-"""seisrack.validation: the paper's validation examples (issue #3)."""
