@@ -66,5 +66,5 @@ def test_report_on_3d_rack_is_a_clear_error(capsys):
     code = main(["report", str(RACK), "--builtin", "elcentro_1940_ns", "--json"])
     assert code == 2
     err = json.loads(capsys.readouterr().out)["error"]
-    assert err["field"] == "geometry.depth"
-    assert "seisrack run" in err["message"]
+    assert err["field"] == "rack"
+    assert "not built for 3D racks" in err["message"]

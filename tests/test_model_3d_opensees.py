@@ -20,11 +20,11 @@ import math
 import numpy as np
 import pytest
 
-from seisrack.fe.assembly3d import assemble_sparse_3d
+from seisrack.fe.assembly import assemble_sparse
+from seisrack.fe.mesh import FrameMesh
 from seisrack.fe.modal import modal_analysis, modal_from_matrices
 from seisrack.model import compile_rack, rack_from_dict
 from seisrack.model.bracing import _pattern_members
-from seisrack.model.rack_mesh3d import Mesh3D
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("openseespy") is None,
                                 reason="openseespy not installed (pip install '.[bench]')")
@@ -67,7 +67,7 @@ def _spring(ops, tag: int, k: float) -> None:
     ops.uniaxialMaterial("Elastic", tag, k)
 
 
-def _ops_periods(mesh: Mesh3D, n: int, *, k_joint: float, k_base: float, k_cross: float,
+def _ops_periods(mesh: FrameMesh, n: int, *, k_joint: float, k_base: float, k_cross: float,
                  lumped: dict[int, float]) -> np.ndarray:
     """First ``n`` periods [s] of the peer model (see the module docstring)."""
     import openseespy.opensees as ops
@@ -199,16 +199,16 @@ def test_braced_upright_frame_alone_matches_opensees(pattern):
     ne, nt = len(el), len(tr)
     k_base = 160e3
     base_rot = [dofs[at[(s, 0.0)]][c] for s in (0, 1) for c in (3, 5)]
-    mesh = Mesh3D(nodes=np.array(nodes), node_dofs=np.array(dofs), elements=np.array(el),
+    mesh = FrameMesh(nodes=np.array(nodes), node_dofs=np.array(dofs), elements=np.array(el),
                   E=np.full(ne, E), G=np.full(ne, G), A=np.full(ne, up["A"]),
-                  Iy=np.full(ne, up["Iy"]), Iz=np.full(ne, up["I"]), J=np.full(ne, up["J"]),
+                  Iy=np.full(ne, up["Iy"]), I=np.full(ne, up["I"]), J=np.full(ne, up["J"]),
                   Ip=np.full(ne, up["J"]), density=np.full(ne, RHO),
                   vecxz=np.tile([0.0, 0.0, 1.0], (ne, 1)), trusses=np.array(tr),
                   truss_E=np.full(nt, E), truss_A=np.full(nt, br["A"]),
                   truss_density=np.full(nt, RHO),
                   springs=np.array([[d, -1] for d in base_rot]),
                   spring_k=np.full(4, k_base), n_dof=n_dof)
-    K, M = assemble_sparse_3d(mesh)
+    K, M = assemble_sparse(mesh)
     tops = [at[(s, ys[-1])] for s in (0, 1)]
     Mt = M.tolil()
     for node in tops:

@@ -1,11 +1,11 @@
-"""Falls and impacts of the pallets of a 3D rack, tracked over every step of a run (issue 11,
-item 4; geometry: :mod:`seisrack.model.pallet_layout3d`).
+"""Falls and impacts of the pallets, tracked over every step of a run (geometry:
+:mod:`seisrack.model.pallet_layout`).
 
-A pallet *falls* cross-aisle the first time its sliding passes its fall distance towards the
-front aisle (−z) or the rear (+z). A down-aisle *impact* is the first time a gap closes
-between two neighbouring pallets, or between an end pallet and its upright; it is reported
-with its closing speed. Crossing times are interpolated linearly between samples. The run
-does not follow a pallet beyond either event (it stays on its beams in the model), so what
+A pallet of a 3D rack *falls* cross-aisle the first time its sliding passes its fall distance
+towards the front aisle (−z) or the rear (+z). A down-aisle *impact* is the first time a gap
+closes between two neighbouring pallets, or between an end pallet and its upright; it is
+reported with its closing speed. Crossing times are interpolated linearly between samples. The
+run does not follow a pallet beyond either event (it stays on its beams in the model), so what
 happens to a pallet after its fall or impact is not physical: the tracker reports first
 occurrences only.
 """
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from seisrack.model.pallet_layout3d import UPRIGHT, PalletLayout3D
+from seisrack.model.pallet_layout import UPRIGHT, PalletLayout
 
 
 @dataclass(frozen=True)
@@ -56,27 +56,33 @@ def _first_crossing(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ContactTracker:
-    """Peaks of sliding (x, z, magnitude), falls and impacts over the chunks of a run."""
+    """Falls (3D racks) and down-aisle impacts over the chunks of a run (an ``on_chunk``
+    callback)."""
 
-    def __init__(self, layout: PalletLayout3D, n_pallets: int) -> None:
+    def __init__(self, layout: PalletLayout, n_pallets: int) -> None:
         self.layout = layout
         m = n_pallets
-        self.peak = np.zeros((m, 3))
         self.fall_time = np.full(m, np.nan)
         self.fall_side = np.zeros(m, dtype=np.int64)  # -1 front, +1 rear
         k = layout.contact_gap.size
         self.impact_time = np.full(k, np.nan)
         self.impact_speed = np.full(k, np.nan)
 
-    def update(self, t: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
-        """One chunk: times (k,), sliding and sliding velocity (k, m, 2)."""
+    def __call__(self, chunk) -> None:  # noqa: ANN001
+        """One chunk of the engine (``on_chunk``); the sliding velocity is asked only where an
+        impact happens (on a line it costs a product with the basis)."""
+        line = chunk.sliding.ndim == 2  # sliders on a line: down-aisle only
+
+        def velocity() -> np.ndarray:
+            return chunk.sliding_v[:, :, None] if line else chunk.sliding_v
+
+        self.update(chunk.t, chunk.sliding[:, :, None] if line else chunk.sliding, velocity)
+
+    def update(self, t: np.ndarray, u: np.ndarray, v) -> None:  # noqa: ANN001
+        """One chunk: times (k,), sliding (k, m, n_dir) and the sliding velocity (the same
+        shape, or a callable giving it)."""
         if u.shape[1] == 0:
             return
-        ax = np.abs(u)
-        np.maximum(self.peak[:, 0], ax[:, :, 0].max(axis=0), out=self.peak[:, 0])
-        np.maximum(self.peak[:, 1], ax[:, :, 1].max(axis=0), out=self.peak[:, 1])
-        np.maximum(self.peak[:, 2], np.hypot(u[:, :, 0], u[:, :, 1]).max(axis=0),
-                   out=self.peak[:, 2])
         lay = self.layout
         open_ = np.flatnonzero(np.isnan(self.fall_time) & np.isfinite(lay.fall_front))
         if open_.size:
@@ -92,13 +98,15 @@ class ContactTracker:
         todo = np.flatnonzero(np.isnan(self.impact_time))
         if todo.size:
             ux = np.zeros((t.size, u.shape[1] + 1))
-            vx = np.zeros_like(ux)
             ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
-            vx[:, :-1] = v[:, :, 0]
             left, right = lay.contact_left[todo], lay.contact_right[todo]
             close = ux[:, left] - ux[:, right] - lay.contact_gap[todo]
-            speed = vx[:, left] - vx[:, right]
             cols, rows = _first_crossing(close)
+            if cols.size == 0:
+                return
+            vx = np.zeros_like(ux)
+            vx[:, :-1] = (v() if callable(v) else v)[:, :, 0]
+            speed = vx[:, left] - vx[:, right]
             grid = np.arange(t.size)
             for c, r in zip(cols, rows, strict=True):
                 self.impact_time[todo[c]] = float(np.interp(r, grid, t))

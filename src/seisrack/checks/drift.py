@@ -70,7 +70,7 @@ def storey_shear_history(model: Any, U: np.ndarray) -> np.ndarray:
     storey = np.asarray(model.element_storey)
     line = np.asarray(model.element_line)
     y0 = model.mesh.nodes[model.mesh.elements[:, 0], 1]
-    n_storey = len(model.level_dofs)
+    n_storey = model.n_level
     picks: list[np.ndarray] = []
     for s in range(n_storey):
         sel = []

@@ -36,7 +36,7 @@ def level_accelerations(model: Any, modal: Any, sa: np.ndarray) -> np.ndarray:
     the level's nodes (EN 1998-1 §4.3.3.3.2, SRSS).
     """
     sa = np.asarray(sa, dtype=float)
-    phi_lv = np.array([modal.shapes[np.asarray(d)].mean(axis=0) for d in model.level_dofs])
+    phi_lv = np.array([modal.shapes[np.asarray(d)].mean(axis=0) for d in model.level_dofs[0]])
     contrib = modal.gamma_x[None, :] * phi_lv * sa[None, :]  # (n_level, n_modes)
     return np.sqrt(np.sum(contrib**2, axis=1))
 
@@ -108,6 +108,5 @@ def pallet_sliding_check(model: Any, modal: Any, *, spectrum: Any = None, record
 
 
 def pallet_levels(model: Any) -> np.ndarray:
-    """(n_pallet,) 0-based beam level of each pallet, from its horizontal DOF."""
-    where = {int(d): i for i, dofs in enumerate(model.level_dofs) for d in np.asarray(dofs)}
-    return np.array([where[int(d)] for d in model.pallet_dof], dtype=int)
+    """(n_pallet,) 0-based beam level of each pallet."""
+    return np.asarray(model.pallet_level, dtype=int)

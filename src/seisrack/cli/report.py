@@ -72,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
     if args.mu is not None:
         spec = with_friction(spec, args.mu)
     model = compile_rack(spec)
+    from seisrack.model.features import require
+
+    require("the engineer's HTML report (seisrack report)", model.ndm, "rack", args.rack)
     rec, _ = _records(args)
     rec, _, scaling = _apply_scaling(args, model, rec, None)
     resp = run_rack(model, rec, rigid_companion=args.rigid_check)

@@ -8,6 +8,7 @@ results with :mod:`seisrack.report.rack_io` and :mod:`seisrack.report.rack_plot`
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -163,6 +164,33 @@ def _result_warnings(resp: Any, model: Any) -> None:
 
 
 # ------------------------------------------------------------------------------ run
+def _motion(args: argparse.Namespace, model: Any) -> tuple[Any, dict[str, Any] | None]:
+    """The ground motion the options describe, scaled as asked: (GroundMotion, scaling)."""
+    from seisrack.cli.run_inputs import _read
+    from seisrack.errors import InputError
+    from seisrack.model.features import require
+    from seisrack.motion import scale_by
+    from seisrack.motion.components import combine
+
+    if args.motion_cross is not None:
+        require("a cross-aisle ground motion component", model.ndm, "--motion-cross",
+                args.motion_cross)
+    if args.angle:
+        require("an incidence angle of the horizontal components", model.ndm, "--angle",
+                args.angle)
+    if not (math.isfinite(args.angle) and -360.0 <= args.angle <= 360.0):
+        raise InputError("--angle", args.angle, "an incidence angle in degrees, -360 to 360")
+    rec, vert = _records(args)
+    cross = None if args.motion_cross is None else _read(args.motion_cross, "--motion-cross",
+                                                          args)
+    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
+    if cross is not None and scaling is not None:
+        cross = scale_by(cross, scaling["factor"])
+    _input_warnings(rec, vert, model.g, scaling is not None)
+    return combine(rec, cross, vert, args.angle,
+                   fields=("--motion", "--motion-cross", "--vertical")), scaling
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -170,36 +198,29 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.model import compile_rack, load_rack, with_friction
+    from seisrack.model.features import require
 
     _check_options(args)
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
     model = compile_rack(spec)
-    if getattr(model, "is_3d", False):
-        from seisrack.cli.run3d import run_3d
-
-        return run_3d(args, spec, model, _progress_bar)
-    from seisrack.cli.run3d import check_2d_options
-
-    check_2d_options(args)
-    rec, vert = _records(args)
-    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
-    _input_warnings(rec, vert, model.g, scaling is not None)
+    if args.method == "exact" and model.n_dir > 1:
+        require("exact modal propagators (method exact)", model.ndm, "--method", args.method)
+    motion, scaling = _motion(args, model)
     try:
-        k = analysis_grid(rec, args.dt)
+        k = analysis_grid(motion, args.dt)
     except InputError as exc:
         raise InputError("--dt", args.dt, exc.allowed) from None
     from seisrack.report.rack_plot import existing_figures
 
     plot, out = output_folder(args, existing_figures)
-    n_pad = int(round(args.free_vibration / rec.dt))
-    n_steps = (rec.n - 1 + n_pad) * k
+    n_pad = int(round(args.free_vibration / motion.dt))
+    n_steps = (motion.n - 1 + n_pad) * k
     bar = _progress_bar(n_steps)
     try:
-        resp = run_rack(model, rec, dt=rec.dt / k, vertical=vert,
-                        free_vibration=args.free_vibration, method=args.method,
-                        basis=args.basis, save_every=args.save_every,
+        resp = run_rack(model, motion, dt=motion.dt / k, free_vibration=args.free_vibration,
+                        method=args.method, basis=args.basis, save_every=args.save_every,
                         rigid_companion=args.rigid_check,
                         progress=None if bar is None else bar.update,
                         **({} if args.accel_filter is None
@@ -209,9 +230,10 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
 
     _result_warnings(resp, model)
-    summary = resp.summary()
-    summary = {"rack": args.rack, "title": spec.title, **summary,
+    summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
                "integration": resp.history.method, "basis": resp.history.basis}
+    if resp.history.work:
+        summary["work"] = resp.history.work
     if scaling is not None:
         scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
         summary["scaling"] = scaling
@@ -220,7 +242,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
     else:
-        print(format_report(resp, spec, rec, vert, summary))
+        print(format_report(resp, spec, motion, summary))
     return 0
 
 
@@ -249,8 +271,8 @@ def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], ou
     if plot:
         from seisrack.report.rack_plot import save_rack_figures
 
-        written += save_rack_figures(resp, out, suptitle=f"{title} - {resp.record_name}",
-                                     force=force)
+        written += save_rack_figures(resp, out, model=model,
+                                     suptitle=f"{title} - {resp.record_name}", force=force)
     summary_path = out / rack_io.SUMMARY_FILE
     written.append(summary_path)
     summary["outputs"] = [str(p) for p in written]

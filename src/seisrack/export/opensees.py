@@ -78,6 +78,10 @@ def opensees_script(
     Returns the script (str), ending with a newline. Run it (``python rack_ops.py`` prints the
     first periods) or import it (``build()``, ``modal(n)``, ``run(ag, dt)``).
     """
+    from seisrack.model.features import require
+
+    require("the OpenSees export (seisrack export opensees)", model.ndm, "model",
+            f"a {model.ndm}D rack")
     if pallets not in PALLET_MODES:
         raise InputError("pallets", pallets, " or ".join(PALLET_MODES))
     if mu is not None and not (np.isfinite(mu) and mu > 0.0):
@@ -183,18 +187,18 @@ def _tables(model: Any, mu: float | None) -> dict[str, list]:
 
     m = int(model.pallet_mass.size)
     mus = np.broadcast_to(np.asarray(model.pallet_mu_static if mu is None else mu, float), (m,))
-    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs[0]) for d in dofs}
     vertical: dict[int, float] = {}
     pallet_rows = []
     for j in range(m):
         mass = float(model.pallet_mass[j])
-        vn = owner[int(model.pallet_vdof[j])][0] + 1
+        vn = owner[int(model.pallet_vdof[j, 0])][0] + 1
         vertical[vn] = vertical.get(vn, 0.0) + mass  # ops.mass replaces: sum per node first
-        bn = owner[int(model.pallet_dof[j])][0] + 1
+        bn = owner[int(model.pallet_dofs[j, 0, 0])][0] + 1
         pallet_rows.append((next_node, bn, mass, float(mus[j]),
-                            level_of_dof[int(model.pallet_dof[j])]))
+                            level_of_dof[int(model.pallet_dofs[j, 0, 0])]))
         next_node += 1
-    levels = [[owner[int(d)][0] + 1 for d in dofs] for dofs in model.level_dofs]
+    levels = [[owner[int(d)][0] + 1 for d in dofs] for dofs in model.level_dofs[0]]
     return {
         "nodes": [(float(x), float(y)) for x, y in mesh.nodes],
         "fix": fix, "equal_dof": equal_dof, "sections": list(sections), "members": members,

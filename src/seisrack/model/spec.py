@@ -213,9 +213,10 @@ class RackSpec:
     bracing: Bracing | None = None  # 3D racks (geometry.depth given)
 
     @property
-    def is_3d(self) -> bool:
-        """True when ``[geometry] depth`` is given: a 3D rack (see ``compile_rack_3d``)."""
-        return self.geometry.depth is not None
+    def ndm(self) -> int:
+        """The rack's dimension: 3 when ``[geometry] depth`` is given (a space frame with
+        upright frames and bracing), else 2 (a plane frame)."""
+        return 2 if self.geometry.depth is None else 3
 
     def beam_section(self, level: int) -> Section:
         """Section of the beams of 0-based ``level``."""

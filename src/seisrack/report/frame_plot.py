@@ -58,7 +58,7 @@ def plot_frame(model: Any, ax: Any = None, *, color: str = "0.6", show_pallets: 
     base = mesh.nodes[model.base_nodes]
     ax.plot(base[:, 0], base[:, 1], "k^", ms=8, clip_on=False)
     if show_pallets and model.n_pallets:
-        p = mesh.nodes[model.pallet_node]
+        p = mesh.nodes[model.pallet_node[:, 0]]
         ax.plot(p[:, 0], p[:, 1], "s", color="tab:orange", ms=7, label="pallets")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
@@ -87,7 +87,12 @@ def plot_mode_shape(model: Any, modal: Any, mode: int = 1, ax: Any = None, *,
 
 
 def save_modes_figure(model: Any, modal: Any, path: str | Path, n_shapes: int = 3) -> Path:
-    """Write a PNG with the undeformed rack and the first ``n_shapes`` mode shapes (Agg)."""
+    """Write a PNG with the undeformed rack and the first ``n_shapes`` mode shapes (Agg); a
+    space rack is drawn in 3D (:mod:`seisrack.report.frame_plot3d`)."""
+    if model.ndm == 3:
+        from seisrack.report.frame_plot3d import save_modes_figure_3d
+
+        return save_modes_figure_3d(model, modal, path, n_shapes)
     import matplotlib
 
     matplotlib.use("Agg")

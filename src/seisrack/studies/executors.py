@@ -124,11 +124,12 @@ def _hook(run) -> None:  # noqa: ANN001
 
 
 def _model(run):  # noqa: ANN001, ANN202
-    """(model with the run's friction, rack spec as loaded, basis) for ``run``.
+    """(model with the run's friction, rack spec as loaded, prepared run) for ``run``.
 
-    Friction enters the compiled model only through its pallet friction arrays, and the
-    engine's basis depends on the structure and the pallet masses only: both are built once
-    per (rack, occupancy) and process; a run replaces the friction arrays (exactly what
+    Friction enters the compiled model only through its pallet friction arrays, and what a
+    run prepares (:func:`seisrack.analysis.prepare_run`: the basis and the operators) depends
+    on the structure and the pallet masses only: both are built once per (rack, occupancy) and
+    process; a run replaces the friction arrays (exactly what
     ``compile_rack(with_friction(rack, mu_s, mu_d))`` gives).
     """
     from dataclasses import replace
@@ -140,41 +141,18 @@ def _model(run):  # noqa: ANN001, ANN202
         from seisrack.studies.expand import apply_pattern
 
         rack = apply_pattern(_CTX.racks[run.rack_hash], _CTX.patterns[key])
+        from seisrack.analysis import prepare_run
+
         model = compile_rack(rack)
-        basis = _basis(model)
-        hit = (model, rack, basis, _operators(model, basis))
+        hit = (model, rack, prepare_run(model))
         if len(_MODELS) >= _CACHE_MAX:
             _MODELS.clear()
         _MODELS[key] = hit
-    model, rack, basis, ops = hit
+    model, rack, prepared = hit
     n = model.pallet_mass.shape[0]
     model = replace(model, pallet_mu_static=np.full(n, float(run.mu_static)),
                     pallet_mu_dynamic=np.full(n, float(run.mu_dynamic)))
-    return model, rack, basis, ops
-
-
-def _operators(model, basis):  # noqa: ANN001, ANN202
-    """The rack operators projected on ``basis`` (friction does not enter them), or None."""
-    if isinstance(basis, str):
-        return None
-    from seisrack.analysis.peaks import rack_operators
-
-    return rack_operators(model, basis.phi)
-
-
-def _basis(model):  # noqa: ANN001, ANN202
-    """The basis ``run_rack(basis="auto")`` would build (or "auto": built by every run)."""
-    try:
-        from seisrack.analysis.hinges import rack_hinges
-        from seisrack.analysis.rack import rack_basis
-        from seisrack.dynamics.sliders import Sliders
-
-        sliders = Sliders(model.pallet_dof, model.pallet_mass, model.pallet_mu_static,
-                          model.pallet_mu_dynamic)
-        # nonlinear connections: the Ritz basis needs their hinge vectors, as in run_rack
-        return rack_basis(model, sliders, "auto", None, rack_hinges(model))
-    except (ImportError, TypeError):  # pragma: no cover - an engine without this helper
-        return "auto"
+    return model, rack, prepared
 
 
 def _scaled(run):  # noqa: ANN001, ANN202
@@ -220,14 +198,14 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
     t0 = time.perf_counter()
     try:
         _hook(run)
-        model, rack, basis, ops = _model(run)
+        model, rack, prepared = _model(run)
         res = run_rack(model, _scaled(run), dt=_CTX.dt, save_every=None, track_energy=False,
-                       throw=False, basis=basis, operators=ops)
+                       throw=False, prepared=prepared)
         if res.status != "ok":
             return failed_row(run, f"solver status: {res.status}", time.perf_counter() - t0)
         fp = res.full_peaks
         sliding = res.pallet_peak_sliding()
-        disp = np.asarray(fp["beam_displacement"], dtype=float)
+        disp = np.asarray(fp["beam_displacement"], dtype=float)[:, 0]
         # drift: an envelope from the per-level peaks (exact for one level; above, peaks of
         # adjacent levels need not be simultaneous)
         heights = np.asarray(rack.geometry.levels, dtype=float)
@@ -237,10 +215,10 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
                 "peak_sliding_max_m": float(sliding.max()) if sliding.size else 0.0,
                 "pallet_peak_sliding_m": [float(s) for s in sliding],
                 "n_pallets": int(res.n_pallets), "any_fall": bool(at_risk),
-                "n_fall": len(at_risk), "base_shear_N": float(fp["base_shear"]),
+                "n_fall": len(at_risk), "base_shear_N": float(np.max(fp["base_shear"])),
                 "beam_displacement_max_m": float(disp.max()),
                 "drift_ratio_max": float(drift.max()),
-                "upright_moment_connection_Nm": float(fp["upright_moment_connection"]),
+                "upright_moment_connection_Nm": float(np.max(fp["upright_moment_connection"])),
                 "wall_time_s": time.perf_counter() - t0}
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, never a stopped study
         kind = "" if isinstance(exc, SeisrackError) else f"{type(exc).__name__}: "

@@ -55,7 +55,7 @@ def plot_elevation(model: Any, spec: Any, peak_sliding: np.ndarray, utilisation:
     norm = mpl.colors.Normalize(vmin=0.0, vmax=vmax)
     cmap = mpl.colormaps["viridis"]
     pallets = list(getattr(spec, "pallets", []) or [])
-    node_xy = mesh.nodes[model.pallet_node]
+    node_xy = mesh.nodes[model.pallet_node[:, 0]]
     for j in range(model.n_pallets):
         w = float(getattr(pallets[j], "width", 1.0)) if j < len(pallets) else 1.0
         x, y = node_xy[j]
