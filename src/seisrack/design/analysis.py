@@ -46,8 +46,9 @@ from seisrack.design.result import DesignResult, Quantity, StoreyCheck
 from seisrack.errors import InputError
 from seisrack.fe.eigen import modal_from_matrices
 
-#: modes computed when not told (all of them for smaller racks)
+#: modes computed first when not told (doubled until 90 % of the mass, up to MAX_MODES)
 DEFAULT_MODES = 30
+MAX_MODES = 480
 
 
 def design_mass(model: Any, factor: float) -> Any:
@@ -119,8 +120,8 @@ def design_analysis(model: Any, spectrum: Any, *, factors: DesignFactors | None 
         :func:`seisrack.motion.ec8_spectrum` the elastic S_e (taken at each mode's damping).
     factors: :class:`DesignFactors` (default values with their sources).
     directions: "down-aisle" and/or "cross-aisle" (3D); default all of the rack's.
-    n_modes: modes computed (default min(n_dof, 30)); the analysis says if they hold less
-        than ``factors.mass_target`` of the mass.
+    n_modes: modes computed; default: 30, doubled until they hold ``factors.mass_target``
+        of the mass in every direction (up to 480). The result notes when they hold less.
     modal_rule: "auto" (SRSS if the relevant modes are well separated, else CQC), "srss", "cqc".
     direction_rule: "srss" or "0.30" (EN 1998-1 §4.3.3.5.1).
     damping: ratio of every mode for CQC and an elastic spectrum (default
@@ -133,17 +134,12 @@ def design_analysis(model: Any, spectrum: Any, *, factors: DesignFactors | None 
     if direction_rule not in DIRECTION_RULES:
         raise InputError("direction_rule", direction_rule, ", ".join(DIRECTION_RULES))
     spectra = _spectra(spectrum, dirs)
-    n = model.n_dof
-    if n_modes is None:
-        k = min(n, DEFAULT_MODES)
-    elif isinstance(n_modes, bool) or not isinstance(n_modes, int) or n_modes < 1:
+    if n_modes is not None and (isinstance(n_modes, bool) or not isinstance(n_modes, int)
+                                or n_modes < 1):
         raise InputError("n_modes", n_modes, "an integer >= 1")
-    else:
-        k = min(n, n_modes)
     M = design_mass(model, f.mass_factor)
     r = {d: influence(model, d) for d in dirs}
-    modes = modal_from_matrices(model.K_sparse, M, r[dirs[0]], model.r_y,
-                                None if k >= n else k)
+    modes = _modes(model, M, r, dirs, n_modes, f.mass_target)
     phi, omega, periods = modes.shapes, modes.omega, modes.periods
     zeta = modal_damping(model, omega, f.damping if damping is None else damping)
     rho = der_kiureghian_rho(omega, zeta)
@@ -214,6 +210,24 @@ def design_analysis(model: Any, spectrum: Any, *, factors: DesignFactors | None 
         direction_rule_text=dtext, quantities=quantities, storeys=storeys,
         factors=f.as_dict(), factor_sources=dict(FACTOR_SOURCES), mass_factor=f.mass_factor,
         notes=tuple(notes))
+
+
+def _modes(model: Any, M: Any, r: dict[str, np.ndarray], dirs: tuple[str, ...],
+           n_modes: int | None, target: float) -> Any:
+    """The modes: ``n_modes`` of them, or (None) from ``DEFAULT_MODES`` up, doubled until
+    they hold ``target`` of the mass in every direction (at most ``MAX_MODES``, or all)."""
+    n = model.n_dof
+    k = min(n, n_modes or DEFAULT_MODES)
+    while True:
+        modes = modal_from_matrices(model.K_sparse, M, r[dirs[0]], model.r_y,
+                                    None if k >= n - 1 else k)
+        if n_modes is not None or k >= min(n - 1, MAX_MODES):
+            return modes
+        phi = modes.shapes
+        if all(float(np.sum((phi.T @ (M @ r[d])) ** 2)) >= target * float(r[d] @ (M @ r[d]))
+               for d in dirs):
+            return modes
+        k = min(2 * k, MAX_MODES, n)
 
 
 def _gravity_state(model: Any) -> np.ndarray:

@@ -18,7 +18,7 @@ T = 0); the analysis offers S_e itself (``spectrum="elastic"``) for an elastic c
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -94,3 +94,31 @@ def design_spectrum(type: int | str = 1, ground: str = "C", ag: float = 0.3, q: 
     kind = el.name.replace("EC8 ", "")
     return EC8DesignSpectrum(el.ag, el.S, el.TB, el.TC, el.TD, q, float(beta),
                              f"EC8 {kind} design spectrum, q = {q:g}")
+
+
+def design_spectra(ec8: tuple[int | str, str, float], q: float | tuple[float, ...],
+                   directions: tuple[str, ...], *, importance: float = 1.0,
+                   beta: float = 0.2, elastic: bool = False, ag_units: str = "g"
+                   ) -> dict[str, object]:
+    """{direction: spectrum} for ``seisrack design`` and the report.
+
+    ec8: (type, ground, a_gR); q: one behaviour factor, or one per direction in the order of
+    ``directions`` (down-aisle first). ``elastic``: the elastic spectrum S_e of §3.2.2.2 (taken
+    at each mode's damping by the analysis) instead of S_d; it needs q = 1.
+    """
+    qs = (q,) if isinstance(q, int | float) else tuple(q)
+    if len(qs) not in (1, len(directions)):
+        raise InputError("--q", list(qs), f"one behaviour factor, or one per direction "
+                         f"({', '.join(directions)})")
+    qs = tuple(check_q(v, "--q") for v in qs)
+    if len(qs) == 1:
+        qs = qs * len(directions)
+    typ, ground, ag = ec8
+    if elastic:
+        if any(v != 1.0 for v in qs):
+            raise InputError("--q", list(qs), "q = 1 with the elastic spectrum (--elastic)")
+        el = ec8_spectrum(typ, ground, ag, importance=importance, ag_units=ag_units)
+        el = replace(el, name=f"{el.name} elastic spectrum (§3.2.2.2)")
+        return {d: el for d in directions}
+    return {d: design_spectrum(typ, ground, ag, qd, importance=importance, beta=beta,
+                               ag_units=ag_units) for d, qd in zip(directions, qs, strict=True)}
