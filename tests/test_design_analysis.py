@@ -273,3 +273,13 @@ def test_design_analysis_bad_input(paper_model) -> None:  # noqa: ANN001
         design_analysis(paper_model, spec, modal_rule="abs")
     with pytest.raises(InputError, match="damping"):
         design_analysis(paper_model, spec, damping=2.0)
+
+
+def test_model_damping_is_the_modal_damping_of_c(paper_model) -> None:  # noqa: ANN001
+    """damping="model": ζ_k = φ_kᵀ C φ_k / (2 ω_k); for the paper rack's stiffness-proportional
+    C = a1 K (a0 = 0) that is a1 ω_k / 2 exactly (Chopra Eq 11.4.9)."""
+    res = design_analysis(paper_model, design_spectrum(1, "C", 0.3, 1.0), damping="model",
+                          factors=NO_UNIT_LOAD)
+    a0, a1 = paper_model.damping_coefficients
+    assert a0 == 0.0
+    np.testing.assert_allclose(res.damping, a1 * res.omega / 2, rtol=1e-9)

@@ -60,14 +60,21 @@ def design_mass(model: Any, factor: float) -> Any:
     return (model.M_sparse + factor * (full - model.M_sparse)).tocsr()
 
 
-def modal_damping(model: Any, omega: np.ndarray, damping: float | str) -> np.ndarray:
-    """(n,) damping ratio of each mode: ``damping`` for all, or ``"model"``: the rack's
-    Rayleigh damping C = a0 M + a1 K, ζ = a0/(2ω) + a1 ω/2 (Chopra Eq 11.4.9)."""
+def modal_damping(model: Any, omega: np.ndarray, damping: float | str,
+                  phi: np.ndarray | None = None) -> np.ndarray:
+    """(n,) damping ratio of each mode: ``damping`` for all, or ``"model"``: the rack's own,
+    ζ_k = φ_kᵀ C φ_k / (2 ω_k) for mass-normalised φ (the diagonal of the modal damping
+    matrix; Chopra §11.5). C = a0·M + a1·K acts on the structure's mass (``C_sparse``), as in
+    the time history, so the unit loads' horizontal mass carries no mass-proportional damping.
+    """
     if isinstance(damping, str):
         if damping != "model":
             raise InputError("damping", damping, "a damping ratio in (0, 1) or 'model'")
-        a0, a1 = model.damping_coefficients
-        return a0 / (2.0 * omega) + a1 * omega / 2.0
+        C = getattr(model, "C_sparse", None)
+        if C is None or phi is None:
+            a0, a1 = model.damping_coefficients
+            return a0 / (2.0 * omega) + a1 * omega / 2.0
+        return np.einsum("ik,ik->k", phi, np.asarray(C @ phi)) / (2.0 * omega)
     if not (isinstance(damping, int | float) and 0 < damping < 1):
         raise InputError("damping", damping, "a damping ratio in (0, 1) or 'model'")
     return np.full(omega.shape, float(damping))
@@ -125,7 +132,8 @@ def design_analysis(model: Any, spectrum: Any, *, factors: DesignFactors | None 
     modal_rule: "auto" (SRSS if the relevant modes are well separated, else CQC), "srss", "cqc".
     direction_rule: "srss" or "0.30" (EN 1998-1 §4.3.3.5.1).
     damping: ratio of every mode for CQC and an elastic spectrum (default
-        ``factors.damping``), or "model" for the rack's Rayleigh damping per mode.
+        ``factors.damping``), or "model" for the rack's own damping per mode
+        (:func:`modal_damping`).
     operators: the named operators to evaluate (default: the storey operators of every
         direction of the rack and its member operators, :mod:`seisrack.design.operators`).
     """
@@ -141,7 +149,7 @@ def design_analysis(model: Any, spectrum: Any, *, factors: DesignFactors | None 
     r = {d: influence(model, d) for d in dirs}
     modes = _modes(model, M, r, dirs, n_modes, f.mass_target)
     phi, omega, periods = modes.shapes, modes.omega, modes.periods
-    zeta = modal_damping(model, omega, f.damping if damping is None else damping)
+    zeta = modal_damping(model, omega, f.damping if damping is None else damping, phi)
     rho = der_kiureghian_rho(omega, zeta)
     gam = {d: phi.T @ (M @ r[d]) for d in dirs}
     m_eff = {d: gam[d] ** 2 for d in dirs}
