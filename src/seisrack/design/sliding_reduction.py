@@ -137,9 +137,9 @@ def one_run_table(model: Any, sliding_resp: Any, rigid_resp: Any, *, mu_static: 
     mus = np.asarray(model.pallet_mu_static, dtype=float)
     mu = float(mu_static if mu_static is not None else (mus.min() if mus.size else math.nan))
     ratios = run_ratios(s, r, mu, float(model.g))
-    rows = [{"quantity": key, "description": desc, "sliding": s[col], "rigid": r[rcol],
+    rows = [{"quantity": key, "description": desc, "sliding": s[col], "rigid": r[col],
              "ratio": ratios[key]}
-            for key, (col, rcol, desc) in QUANTITIES.items()]
+            for key, (col, _, desc) in QUANTITIES.items()]
     rows.append({"quantity": "pallet_force", "description": "peak total pallet-beam force",
                  "sliding": s["pallet_force_N"], "rigid": r["pallet_force_N"],
                  "ratio": (s["pallet_force_N"] / r["pallet_force_N"]
