@@ -39,6 +39,8 @@ import numpy as np
 
 from seisrack.errors import InputError, SeisrackError
 from seisrack.studies import fragility as fr
+from seisrack.studies.reduction_summary import COLUMNS as REDUCTION_COLUMNS
+from seisrack.studies.reduction_summary import format_reduction, reduction_summary
 
 __all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
 
@@ -48,7 +50,8 @@ DEFAULT_D_SLIDE = (0.05,)  # [m]
 PEAKS = ("peak_sliding_max_m", "n_fall", "base_shear_N", "beam_displacement_max_m",
          "drift_ratio_max", "upright_moment_connection_Nm")
 _STR = ("run_id", "rack", "record", "im_measure", "status", "error")
-_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS
+_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS \
+    + tuple(c for c in REDUCTION_COLUMNS if c not in PEAKS)
 CSV_FIELDS = ("name", "theta", "beta", "theta_lo", "theta_hi", "beta_lo", "beta_hi",
               "n_stripes", "n_runs", "rack", "im_measure", "method", "status")
 
@@ -263,6 +266,9 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
             g["stripes"] = _stripes(r, ms, states, n_boot, seed)
         if ida.size:
             g["ida"] = _ida(r, ida, states, n_boot, seed)
+        red = reduction_summary(r, idx)
+        if red is not None:
+            g["sliding_reduction"] = red
         for kind in ("stripes", "ida"):
             for name, f in g.get(kind, {}).get("fragility", {}).items():
                 boot_store.append((rack, meas, kind, name, f.pop("_boot", None)))
@@ -334,6 +340,19 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
         fig.savefig(folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
+    red = [g for g in summary["groups"] if "sliding_reduction" in g]
+    if red:
+        from seisrack.report.sliding_reduction_plot import plot_sliding_reduction
+
+        fig, axes = plt.subplots(1, len(red), figsize=(6.4 * len(red), 4.4), squeeze=False)
+        for ax, g in zip(axes[0], red, strict=True):
+            sr = g["sliding_reduction"]
+            plot_sliding_reduction(sr["points"], sr["code_nominal"]["down-aisle"], ax=ax)
+            ax.set_title(Path(g["rack"]).name, fontsize="small")
+        fig.tight_layout()
+        fig.savefig(folder / "sliding_reduction.png", dpi=120)
+        plt.close(fig)
+        files["sliding_reduction_png"] = str(folder / "sliding_reduction.png")
     return files
 
 
@@ -374,6 +393,8 @@ def format_summary(s: dict[str, Any]) -> str:
                              f" {_fmt(nf['mean'])}")
         if "ida" in g:
             lines.append(f"  IDA: {len(g['ida']['curves'])} curves")
+        if "sliding_reduction" in g:
+            lines += format_reduction(g["sliding_reduction"])
     lines.append("\nfragility (theta [m/s²], beta; 90 % bootstrap band)")
     for f in s["fragility"]:
         lines.append(f"  {f['analysis']:7s} {f['name']:22s} theta {_fmt(f['theta']):>7} "
