@@ -122,3 +122,18 @@ def test_old_store_without_rigid_columns(study, tmp_path) -> None:  # noqa: ANN0
         pq.write_table(t, tmp_path / "runs" / f"part-{i}.parquet")
     s = summarize(tmp_path, n_boot=0, plots=False)
     assert s["runs_ok"] == 8 and "sliding_reduction" not in s["groups"][0]
+
+
+def test_study_report_reduction_section(study, tmp_path) -> None:  # noqa: ANN001
+    pytest.importorskip("matplotlib")
+    from seisrack.studies.summary import summary_main
+
+    _, out, _ = study
+    html = tmp_path / "s.html"
+    assert summary_main([str(out), "--boot", "0", "--report", str(html)]) == 0
+    text = html.read_text(encoding="utf-8")
+    assert '<section id="sliding-reduction">' in text
+    assert 'id="fig-sliding-reduction-0"' in text and "E_D1·E_D2·E_D3" in text
+    s = json.loads((out / "summary" / "summary.json").read_text())
+    mean = s["groups"][0]["sliding_reduction"]["rows"][0]["base_shear"]["mean"]
+    assert f'data-value="{json.dumps(mean)}"' in text
