@@ -351,26 +351,10 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
         fig.savefig(folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
-    red = [g for g in summary["groups"] if "sliding_reduction" in g]
-    if red:
-        from seisrack.report.sliding_reduction_plot import plot_sliding_reduction
+    from seisrack.report.study_figures import save_reduction_figure, save_risk_figure
 
-        fig, axes = plt.subplots(1, len(red), figsize=(6.4 * len(red), 4.4), squeeze=False)
-        for ax, g in zip(axes[0], red, strict=True):
-            sr = g["sliding_reduction"]
-            plot_sliding_reduction(sr["points"], sr["code_nominal"]["down-aisle"], ax=ax)
-            ax.set_title(Path(g["rack"]).name, fontsize="small")
-        fig.tight_layout()
-        fig.savefig(folder / "sliding_reduction.png", dpi=120)
-        plt.close(fig)
-        files["sliding_reduction_png"] = str(folder / "sliding_reduction.png")
-    if "risk" in summary:
-        from seisrack.report.risk_plot import plot_risk
-
-        ax = plot_risk(summary["risk"])
-        ax.figure.savefig(folder / "risk.png", dpi=120)
-        plt.close(ax.figure)
-        files["risk_png"] = str(folder / "risk.png")
+    files.update(save_reduction_figure(folder, summary))
+    files.update(save_risk_figure(folder, summary))
     return files
 
 
