@@ -27,6 +27,7 @@ _COMMAND_MODULES = (
     "seisrack.cli.study",
     "seisrack.cli.export",
     "seisrack.cli.report",
+    "seisrack.cli.design",
 )
 
 

@@ -36,7 +36,12 @@ def register(subparsers: Any) -> None:
                    help="the HTML report (default report.html); summary.json goes beside it")
     p.add_argument("--rigid-check", action="store_true",
                    help="also run the rack with rigidly held pallets, so the mu >= alpha rule "
-                        "uses the designer's (rigid) alpha")
+                        "uses the designer's (rigid) alpha, and report the force reduction "
+                        "sliding gives (peaks sliding / rigid)")
+    p.add_argument("--q", type=float, nargs="+", default=[1.0], metavar="Q",
+                   help="behaviour factor of the design analysis run with --ec8 (default 1)")
+    p.add_argument("--factors", nargs="+", metavar="KEY=VALUE",
+                   help="design analysis factors, e.g. e_d1=1.0 (see seisrack design)")
     p.add_argument("--force", action="store_true", help="overwrite an existing report")
     from seisrack.cli.run import _register_scaling
 
@@ -67,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--out", str(summary_path), "a folder without summary.json",
                          hint="Pass --force to overwrite it")
     design = _design_spectrum(args.ec8)
+    from seisrack.design import parse_factor_overrides
+
+    factors = parse_factor_overrides(getattr(args, "factors", None))
     vars(args).setdefault("vertical", None)
     spec = load_rack(args.rack)
     if args.mu is not None:
@@ -85,9 +93,14 @@ def run(args: argparse.Namespace) -> int:
     if scaling is not None:
         summary["scaling"] = scaling
     summary["design_checks"] = checks
+    section = _design_section(args, model, resp, rec, factors)
+    if section.get("design") is not None:
+        summary["design_analysis"] = section["design"]
+    if section.get("reduction") is not None:
+        summary["sliding_reduction"] = section["reduction"]
     write_html_report(out, spec=spec, model=model, response=resp, record=rec, summary=summary,
                       modal=modal, checks=checks, force=args.force, design_spectrum=design,
-                      rack_file=args.rack)
+                      rack_file=args.rack, design_section=section)
     summary["outputs"] = [str(out), str(summary_path)]
     write_summary_json(summary, summary_path)
     if args.json:
@@ -98,7 +111,47 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {c['title']}: {c['verdict']}")
         for d in checks["disagreements"]:
             print(f"  DISAGREES with the time history: {d}")
+        if "design_analysis" in summary:
+            da = summary["design_analysis"]["quantities"]["base_shear_x"]
+            print(f"  design analysis (EN 1998-1 modal response spectrum): base shear "
+                  f"{da['max'] / 1e3:.3f} kN")
+        if "sliding_reduction" in summary:
+            r = summary["sliding_reduction"]
+            print("  sliding / rigid peaks: " + ", ".join(
+                f"{row['quantity']} {row['ratio']:.3f}" for row in r["rows"])
+                + f" (mu/alpha = {r['mu_over_alpha']:.3f})")
     return 0
+
+
+def _design_section(args: argparse.Namespace, model: Any, resp: Any, rec: Any,
+                    factors: Any) -> dict[str, Any]:
+    """The report's design section: the design analysis (with --ec8) beside this run's peaks,
+    and the sliding reduction (with --rigid-check, needs pallets)."""
+    from seisrack.design import design_analysis
+    from seisrack.design.sliding_reduction import one_run_table, response_peaks, rigid_model
+    from seisrack.design.spectrum import design_spectra
+    from seisrack.report.html.design import beside_rows
+
+    out: dict[str, Any] = {}
+    spectra = None
+    if args.ec8 is not None:
+        kind, ground, ag = args.ec8
+        spectra = design_spectra((kind, ground.upper(), float(ag)), tuple(args.q),
+                                 ("down-aisle",), beta=factors.beta)
+        res = design_analysis(model, spectra, factors=factors)
+        out["design"] = res.as_dict()
+        out["beside"] = beside_rows(res, response_peaks(resp))
+    else:
+        out["note"] = ("Give --ec8 TYPE GROUND AG (and --q) to run the design analysis; "
+                       "the sliding reduction needs --rigid-check.")
+    if args.rigid_check and model.n_pallets:
+        from seisrack.analysis import run_rack
+
+        rigid = run_rack(rigid_model(model), rec, save_every=None, track_energy=False)
+        out["reduction"] = one_run_table(model, resp, rigid, factors=factors,
+                                         spectrum=None if spectra is None
+                                         else spectra["down-aisle"])
+    return out
 
 
 def _design_spectrum(ec8: list[str] | None) -> Any:

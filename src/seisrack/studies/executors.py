@@ -52,6 +52,7 @@ _CTX: Any = None  # the StudyPlan (without its runs) of the current process
 _CTX_ID: str | None = None
 _MODELS: dict = {}
 _RECORDS: dict = {}
+_RIGID: dict = {}  # rigid-pallet companion peaks by (rack, occupancy, record, scale)
 _LIMITER: Any = None
 _CACHE_MAX = 128
 
@@ -63,6 +64,7 @@ def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
     _CTX, _CTX_ID = ctx, ctx_id
     _MODELS.clear()
     _RECORDS.clear()
+    _RIGID.clear()
     if _LIMITER is None:
         from threadpoolctl import threadpool_limits
 
@@ -182,7 +184,8 @@ def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # n
     return {**_inputs(run), "status": "failed", "error": reason, "peak_sliding_max_m": nan,
             "pallet_peak_sliding_m": [], "n_pallets": 0, "any_fall": False, "n_fall": 0,
             "base_shear_N": nan, "beam_displacement_max_m": nan, "drift_ratio_max": nan,
-            "upright_moment_connection_Nm": nan, "wall_time_s": wall}
+            "upright_moment_connection_Nm": nan, "wall_time_s": wall,
+            **dict.fromkeys(REDUCTION_COLUMNS, nan)}
 
 
 def skipped_row(run, stop_im: float, rule) -> dict[str, Any]:  # noqa: ANN001
@@ -219,10 +222,51 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
                 "beam_displacement_max_m": float(disp.max()),
                 "drift_ratio_max": float(drift.max()),
                 "upright_moment_connection_Nm": float(np.max(fp["upright_moment_connection"])),
+                **_reduction_columns(run, res, model, prepared),
                 "wall_time_s": time.perf_counter() - t0}
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, never a stopped study
         kind = "" if isinstance(exc, SeisrackError) else f"{type(exc).__name__}: "
         return failed_row(run, f"{kind}{exc}", time.perf_counter() - t0)
+
+
+#: columns of the sliding reduction (issue 24 item 2): this run's seismic connector and upright
+#: moments, and the peaks of the same rack and scaled record with the pallets held rigidly
+#: (rigid_alpha: its peak absolute level acceleration over g, the paper's alpha)
+REDUCTION_COLUMNS = ("connector_moment_Nm", "upright_moment_Nm", "rigid_base_shear_N",
+                     "rigid_connector_moment_Nm", "rigid_upright_moment_Nm",
+                     "rigid_alpha")
+
+
+def _reduction_columns(run, res, model, prepared) -> dict[str, float]:  # noqa: ANN001
+    """This run's peaks for the sliding reduction and its rigid companion's (the rigid run
+    depends on the rack, occupancy, record and scale only: one per process and key)."""
+    from seisrack.design.sliding_reduction import response_peaks, rigid_model
+
+    mine = response_peaks(res)
+    key = (run.rack_hash, run.occupancy, run.record_hash, run.scale_factor)
+    rigid = _RIGID.get(key)
+    if rigid is None:
+        rigid = dict.fromkeys(REDUCTION_COLUMNS[2:], math.nan)
+        if model.n_pallets:
+            from seisrack.analysis import run_rack
+
+            try:
+                r = run_rack(rigid_model(model), _scaled(run), dt=_CTX.dt, save_every=None,
+                             track_energy=False, throw=False, prepared=prepared)
+            except Exception as exc:  # noqa: BLE001 - the companion never fails the run
+                log.warning("rigid companion of run %s failed: %s", run.run_id, exc)
+                r = None
+            if r is not None and r.status == "ok":
+                p = response_peaks(r)
+                rigid = {"rigid_base_shear_N": p["base_shear_N"],
+                         "rigid_connector_moment_Nm": p["connector_moment_Nm"],
+                         "rigid_upright_moment_Nm": p["upright_moment_Nm"],
+                         "rigid_alpha": p["level_acceleration_m_s2"] / float(model.g)}
+        if len(_RIGID) >= _CACHE_MAX:
+            _RIGID.clear()
+        _RIGID[key] = rigid
+    return {"connector_moment_Nm": mine["connector_moment_Nm"],
+            "upright_moment_Nm": mine["upright_moment_Nm"], **rigid}
 
 
 def _context_of(plan) -> Any:  # noqa: ANN001

@@ -39,6 +39,8 @@ import numpy as np
 
 from seisrack.errors import InputError, SeisrackError
 from seisrack.studies import fragility as fr
+from seisrack.studies.reduction_summary import COLUMNS as REDUCTION_COLUMNS
+from seisrack.studies.reduction_summary import format_reduction, reduction_summary
 
 __all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
 
@@ -48,7 +50,8 @@ DEFAULT_D_SLIDE = (0.05,)  # [m]
 PEAKS = ("peak_sliding_max_m", "n_fall", "base_shear_N", "beam_displacement_max_m",
          "drift_ratio_max", "upright_moment_connection_Nm")
 _STR = ("run_id", "rack", "record", "im_measure", "status", "error")
-_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS
+_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS \
+    + tuple(c for c in REDUCTION_COLUMNS if c not in PEAKS)
 CSV_FIELDS = ("name", "theta", "beta", "theta_lo", "theta_hi", "beta_lo", "beta_hi",
               "n_stripes", "n_runs", "rack", "im_measure", "method", "status")
 
@@ -215,13 +218,15 @@ def _capacity(cv: dict[str, Any], col: str, thr: float) -> float:
 
 def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: float | None = None,
               n_boot: int = 200, seed: int = 0, write: bool = True, plots: bool = True,
-              boots: list | None = None) -> dict[str, Any]:
+              boots: list | None = None, hazard: str | Path | None = None) -> dict[str, Any]:
     """Summary of the study stored in ``out_dir`` (see the module docstring).
 
     d_slide: sliding thresholds [m] (a float or a sequence); shear_capacity: base shear [N] for
     the ``base_shear>V`` damage state (omitted when None); n_boot: bootstrap resamples per fit;
     boots: a list that receives ``(rack, im_measure, kind, state, (thetas, betas))`` per fit
-    (the bootstrap samples, for the bands of the HTML report).
+    (the bootstrap samples, for the bands of the HTML report); hazard: a site hazard curve CSV
+    in the study's intensity measure: adds ``risk`` (mean annual frequency and 50-year
+    probability of each fitted fragility, :mod:`seisrack.studies.risk`).
     Returns the dict written to ``summary.json``.
     """
     out = Path(out_dir)
@@ -238,6 +243,11 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
                          hint="The study has no finished run yet; run or resume it first")
     r = runs_as_arrays(table)
+    curve = None
+    if hazard is not None:  # checked before any fit
+        from seisrack.studies.risk import load_hazard_curve
+
+        curve = load_hazard_curve(hazard, tuple(sorted(set(r["im_measure"]))))
     states = _damage_states(d_slide, shear_capacity)
     status = r["status"]
     failed = status == "failed"
@@ -263,6 +273,9 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
             g["stripes"] = _stripes(r, ms, states, n_boot, seed)
         if ida.size:
             g["ida"] = _ida(r, ida, states, n_boot, seed)
+        red = reduction_summary(r, idx)
+        if red is not None:
+            g["sliding_reduction"] = red
         for kind in ("stripes", "ida"):
             for name, f in g.get(kind, {}).get("fragility", {}).items():
                 boot_store.append((rack, meas, kind, name, f.pop("_boot", None)))
@@ -270,6 +283,10 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
                 summary["fragility"].append({"name": name, "rack": rack, "im_measure": meas,
                                              "analysis": kind, **row})
         summary["groups"].append(g)
+    if curve is not None:
+        from seisrack.studies.risk import risk_summary
+
+        summary["risk"] = {"file": str(hazard), **risk_summary(curve, summary["fragility"])}
     if boots is not None:
         boots.extend(boot_store)
     if write:
@@ -334,6 +351,10 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
         fig.savefig(folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
+    from seisrack.report.study_figures import save_reduction_figure, save_risk_figure
+
+    files.update(save_reduction_figure(folder, summary))
+    files.update(save_risk_figure(folder, summary))
     return files
 
 
@@ -374,6 +395,8 @@ def format_summary(s: dict[str, Any]) -> str:
                              f" {_fmt(nf['mean'])}")
         if "ida" in g:
             lines.append(f"  IDA: {len(g['ida']['curves'])} curves")
+        if "sliding_reduction" in g:
+            lines += format_reduction(g["sliding_reduction"])
     lines.append("\nfragility (theta [m/s²], beta; 90 % bootstrap band)")
     for f in s["fragility"]:
         lines.append(f"  {f['analysis']:7s} {f['name']:22s} theta {_fmt(f['theta']):>7} "
@@ -394,6 +417,10 @@ def format_summary(s: dict[str, Any]) -> str:
     }
     seen = [st for st in notes if any(f["status"] == st for f in s["fragility"])]
     lines += [f"  note: {notes[st]}" for st in seen]
+    if "risk" in s:
+        from seisrack.studies.risk import format_risk
+
+        lines += format_risk(s["risk"])
     if "files" in s:
         lines.append("\nwritten: " + ", ".join(s["files"].values()))
     return "\n".join(lines)
@@ -413,6 +440,10 @@ def summary_main(argv: list[str]) -> int:
     p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--hazard", metavar="FILE.csv", default=None,
+                   help="site hazard curve (CSV: '# measure = pga', '# units = g', then "
+                        "im,annual_frequency): mean annual frequency and 50-year probability "
+                        "of each fragility")
     p.add_argument("--report", metavar="FILE.html", default=None,
                    help="also write the study's self-contained HTML report")
     p.add_argument("--force", action="store_true", help="overwrite an existing --report")
@@ -430,7 +461,8 @@ def summary_main(argv: list[str]) -> int:
 
             check_report_path(a.report, a.force, field="--report")
         s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
-                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots)
+                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots,
+                      hazard=a.hazard)
         if a.report:
             from seisrack.report.html import write_study_report
 

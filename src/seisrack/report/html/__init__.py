@@ -57,13 +57,16 @@ def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, re
                       record: Any, summary: dict[str, Any], modal: Any = None,
                       checks: dict[str, Any] | None = None, force: bool = False,
                       design_spectrum: Any = None, rack_file: str | None = None,
-                      seed: int | None = None, interactive: bool | None = None) -> Path:
+                      seed: int | None = None, interactive: bool | None = None,
+                      design_section: dict[str, Any] | None = None) -> Path:
     """Write the HTML report of ``response`` (a RackResponse of ``model`` under ``record``).
 
     summary: the dict written to summary.json (the tables show its numbers exactly);
     modal: ModalResult (modal section skipped if None); checks: the result of
     :func:`seisrack.checks.run_design_checks`; design_spectrum: EC8 spectrum drawn against the
-    record's spectrum; interactive: use plotly (default: if installed).
+    record's spectrum; interactive: use plotly (default: if installed); design_section: the
+    keyword arguments of :func:`seisrack.report.html.design.design_section_html` (the design
+    analysis and the sliding reduction), section omitted if None.
     Raises InputError if ``path`` exists (without ``force``) or cannot be written.
     """
     p = check_report_path(path, force)
@@ -71,5 +74,5 @@ def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, re
                       summary=summary, modal=modal, checks=checks,
                       design_spectrum=design_spectrum, rack_file=rack_file, seed=seed,
                       interactive=interactive, date=_dt.datetime.now().isoformat(
-                          timespec="seconds"))
+                          timespec="seconds"), design_section=design_section)
     return write_atomically(p, text)

@@ -9,6 +9,7 @@ import numpy as np
 from seisrack import __version__
 from seisrack.report.html import figures as F
 from seisrack.report.html.connections import connections_html
+from seisrack.report.html.design import design_section_html
 from seisrack.report.html.style import CSS
 from seisrack.report.html.tables import (
     esc,
@@ -25,7 +26,8 @@ N_WORST = 5
 KNOWN_KEYS = {"record", "g_m_s2", "dt_s", "duration_s", "status", "peaks", "sliding_occurred",
               "pallets_at_risk", "pallets", "simplified_check", "n_events", "n_slip_events",
               "energy_balance_error", "rack", "title", "integration", "basis", "scaling",
-              "outputs", "design_checks", "modal", "report", "seed", "hinges"}
+              "outputs", "design_checks", "modal", "report", "seed", "hinges",
+              "design_analysis", "sliding_reduction"}
 
 
 def _figure(fig_id: str, src: str, caption: str) -> str:
@@ -187,7 +189,8 @@ def _rows_table(tid: str, rows: list[dict[str, Any]], cols: list[tuple[str, str,
 def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: dict[str, Any],
                modal: Any = None, checks: dict[str, Any] | None = None,
                design_spectrum: Any = None, rack_file: str | None = None,
-               seed: int | None = None, interactive: bool | None = None, date: str = "") -> str:
+               seed: int | None = None, interactive: bool | None = None, date: str = "",
+               design_section: dict[str, Any] | None = None) -> str:
     """The report as one HTML string (see :func:`write_html_report`)."""
     import matplotlib
 
@@ -240,6 +243,8 @@ def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: di
     if checks is not None:
         sec.append(f'<section id="checks"><h2>{8 if conn else 7}. Design checks beside the '
                    "time history</h2>" + _checks_html(checks) + "</section>")
+    if design_section:
+        sec.append(design_section_html(7 + bool(conn) + (checks is not None), **design_section))
     verdict = (f"{n_risk} pallet(s) may fall" if n_risk else "no pallet reached its free "
                "distance") + ("; pallets slid" if summary.get("sliding_occurred") else
                               "; no sliding")
