@@ -17,14 +17,10 @@ def register(subparsers: Any) -> None:
                     "design checks (FEM 10.2.08 / EN 16681 pallet sliding, EN 1998-1 θ, the "
                     "paper's mu >= alpha rule), and write one self-contained HTML file (opens "
                     "offline, prints on A4) plus summary.json beside it. Units: SI.")
-    p.add_argument("rack", help="rack description (TOML)")
-    src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--motion", metavar="FILE",
-                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
-    src.add_argument("--builtin", metavar="NAME", help="a bundled record (e.g. elcentro_1940_ns)")
-    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2'")
-    p.add_argument("--motion-dt", type=float, metavar="DT",
-                   help="[s] time step of a one-column record file")
+    p.add_argument("rack", help="rack description (TOML), 2D or 3D")
+    from seisrack.cli.run_inputs import register_motion_options
+
+    register_motion_options(p)
     p.add_argument("--mu", type=float, metavar="MU",
                    help="static (and dynamic) friction coefficient of every pallet")
     p.add_argument("--ec8", nargs=3, metavar=("TYPE", "GROUND", "AG"),
@@ -55,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.analysis import run_rack
     from seisrack.checks import run_design_checks
     from seisrack.cli._common import print_json
-    from seisrack.cli.run import _apply_scaling, _records
+    from seisrack.cli.run_inputs import ground_motion_from_args
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
     from seisrack.model import compile_rack, load_rack, with_friction
@@ -75,16 +71,11 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.design import parse_factor_overrides
 
     factors = parse_factor_overrides(getattr(args, "factors", None))
-    vars(args).setdefault("vertical", None)
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu)
     model = compile_rack(spec)
-    from seisrack.model.features import require
-
-    require("the engineer's HTML report (seisrack report)", model.ndm, "rack", args.rack)
-    rec, _ = _records(args)
-    rec, _, scaling = _apply_scaling(args, model, rec, None)
+    rec, scaling = ground_motion_from_args(args, model)
     resp = run_rack(model, rec, rigid_companion=args.rigid_check)
     modal = modal_analysis(model, n_modes=min(args.modes, model.n_dof))
     checks = run_design_checks(model, resp, modal=modal, spectrum=design, record=rec)
@@ -137,7 +128,7 @@ def _design_section(args: argparse.Namespace, model: Any, resp: Any, rec: Any,
     if args.ec8 is not None:
         kind, ground, ag = args.ec8
         spectra = design_spectra((kind, ground.upper(), float(ag)), tuple(args.q),
-                                 ("down-aisle",), beta=factors.beta)
+                                 tuple(model.directions), beta=factors.beta)
         res = design_analysis(model, spectra, factors=factors)
         out["design"] = res.as_dict()
         out["beside"] = beside_rows(res, response_peaks(resp))

@@ -8,7 +8,6 @@ results with :mod:`seisrack.report.rack_io` and :mod:`seisrack.report.rack_plot`
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -20,7 +19,9 @@ from seisrack.cli.run_inputs import (  # noqa: F401  (re-exported: report.py, te
     _check_number,
     _input_warnings,
     _records,
+    ground_motion_from_args,
     output_folder,
+    register_motion_options,
     warn,
 )
 from seisrack.cli.run_text import format_report
@@ -46,24 +47,7 @@ def register(subparsers: Any) -> None:
                     "force, base shear, upright moments, and each pallet's sliding against its "
                     "fall limit (paper §IV). Units: SI (m, s, kg, N).")
     p.add_argument("rack", help="rack description (TOML)")
-    src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--motion", metavar="FILE",
-                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
-    src.add_argument("--builtin", metavar="NAME",
-                     help="a bundled record instead of --motion (e.g. elcentro_1940_ns)")
-    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2' (not needed for "
-                                   ".AT2 or seisrack CSV files)")
-    p.add_argument("--motion-dt", type=float, metavar="DT",
-                   help="[s] time step of a one-column record file")
-    p.add_argument("--motion-cross", metavar="FILE",
-                   help="3D racks: cross-aisle ground acceleration (the second horizontal "
-                        "component; same units, dt and length as --motion)")
-    p.add_argument("--angle", type=float, default=0.0, metavar="DEG",
-                   help="3D racks: incidence angle [deg] turning the horizontal pair from the "
-                        "down-aisle axis towards the cross-aisle one (default 0)")
-    p.add_argument("--vertical", metavar="FILE",
-                   help="vertical ground acceleration, same units, dt and length as the "
-                        "horizontal record (pallet normal forces become m (g + a_v))")
+    register_motion_options(p)
     p.add_argument("--mu", type=float, metavar="MU",
                    help="static friction coefficient of every pallet (overrides the file)")
     p.add_argument("--mu-dynamic", type=float, metavar="MUD",
@@ -164,33 +148,6 @@ def _result_warnings(resp: Any, model: Any) -> None:
 
 
 # ------------------------------------------------------------------------------ run
-def _motion(args: argparse.Namespace, model: Any) -> tuple[Any, dict[str, Any] | None]:
-    """The ground motion the options describe, scaled as asked: (GroundMotion, scaling)."""
-    from seisrack.cli.run_inputs import _read
-    from seisrack.errors import InputError
-    from seisrack.model.features import require
-    from seisrack.motion import scale_by
-    from seisrack.motion.components import combine
-
-    if args.motion_cross is not None:
-        require("a cross-aisle ground motion component", model.ndm, "--motion-cross",
-                args.motion_cross)
-    if args.angle:
-        require("an incidence angle of the horizontal components", model.ndm, "--angle",
-                args.angle)
-    if not (math.isfinite(args.angle) and -360.0 <= args.angle <= 360.0):
-        raise InputError("--angle", args.angle, "an incidence angle in degrees, -360 to 360")
-    rec, vert = _records(args)
-    cross = None if args.motion_cross is None else _read(args.motion_cross, "--motion-cross",
-                                                          args)
-    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
-    if cross is not None and scaling is not None:
-        cross = scale_by(cross, scaling["factor"])
-    _input_warnings(rec, vert, model.g, scaling is not None)
-    return combine(rec, cross, vert, args.angle,
-                   fields=("--motion", "--motion-cross", "--vertical")), scaling
-
-
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -207,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
     model = compile_rack(spec)
     if args.method == "exact" and model.n_dir > 1:
         require("exact modal propagators (method exact)", model.ndm, "--method", args.method)
-    motion, scaling = _motion(args, model)
+    motion, scaling = ground_motion_from_args(args, model)
     try:
         k = analysis_grid(motion, args.dt)
     except InputError as exc:

@@ -21,7 +21,6 @@ FEATURES: dict[str, tuple[int, ...]] = {
     "exact modal propagators (method exact)": (2,),
     "a cross-aisle ground motion component": (3,),
     "the OpenSees export (seisrack export opensees)": (2,),
-    "the engineer's HTML report (seisrack report)": (2,),
     "an incidence angle of the horizontal components": (3,),
 }
 

@@ -455,6 +455,9 @@ def _save_plan_view(resp: RackResponse, model: Any, out: Path, suptitle: str | N
     if suptitle:
         title = fig.get_suptitle()
         fig.suptitle(f"{suptitle}\n{title}" if title else suptitle, fontsize=9)
-    fig.tight_layout()
-    save(fig.axes[0], str(out / SLIDING_PATHS_FIGURE))
+        fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.65 / fig.get_figheight()))
+    fig.savefig(out / SLIDING_PATHS_FIGURE, dpi=120)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
     return out / SLIDING_PATHS_FIGURE

@@ -116,4 +116,6 @@ def plot_sliding_paths(
     fig.suptitle(f"Pallet sliding in plan: {resp.record_name}, angle {resp.angle_deg:g}°"
                  "\ndashed: fall limits (magnified like the paths); red: the pallet falls",
                  fontsize=10)
+    # leave room for the two-line title above the panels' own titles
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.5 / fig.get_figheight()))
     return fig
