@@ -136,13 +136,16 @@ def _dry_run(args: argparse.Namespace, spec, pl) -> int:  # noqa: ANN001
     for lv in levels:
         print(f"  {kind} {lv['stripe']:>3}  {spec.intensity.measure} = {lv['im_target']:.4g} "
               f"{unit}: {lv['runs']} runs")
+    planar = any(r.angle_deg != 0.0 or r.components > 1 for r in runs)
     head = f"{'run_id':<16} {'rack':<20} {'record':<26} {'IM [m/s²]':>10} {'scale':>7} " \
-           f"{'mu_s':>6} {'mu_d':>6} {'occ':>5}"
+           f"{'mu_s':>6} {'mu_d':>6} {'occ':>5}" + (f" {'comp':>4} {'angle':>6}" if planar
+                                                    else "")
     print(head)
     for r in runs[:12]:
         print(f"{r.run_id:<16} {r.rack[-20:]:<20} {r.record[:26]:<26} {r.im_target:>10.4g} "
               f"{r.scale_factor:>7.3f} {r.mu_static:>6.3f} {r.mu_dynamic:>6.3f} "
-              f"{r.occupancy:>5.2f}")
+              f"{r.occupancy:>5.2f}" + (f" {r.components:>4} {r.angle_deg:>6.1f}" if planar
+                                        else ""))
     if len(runs) > 12:
         print(f"... {len(runs) - 12} more (--json lists them all)")
     sys.stdout.flush()

@@ -158,14 +158,20 @@ def _model(run):  # noqa: ANN001, ANN202
 
 
 def _scaled(run):  # noqa: ANN001, ANN202
-    key = (run.record_hash, run.scale_factor)
+    """The run's ground motion: its record (every component) scaled by the run's factor, a
+    pair or a turned motion as a GroundMotion (3D racks)."""
+    key = (run.record_hash, run.scale_factor, getattr(run, "angle_deg", 0.0))
     rec = _RECORDS.get(key)
     if rec is None:
         from seisrack.motion import Record
+        from seisrack.motion.components import combine
 
-        base = _CTX.records[run.record_hash]
-        rec = Record(base.accel * run.scale_factor, base.dt, name=base.name,
-                     provenance=f"{base.provenance}, scaled by {run.scale_factor:.6g}")
+        comps = tuple(Record(c.accel * run.scale_factor, c.dt, name=c.name,
+                             provenance=f"{c.provenance}, scaled by {run.scale_factor:.6g}")
+                      for c in _CTX.records[run.record_hash])
+        angle = getattr(run, "angle_deg", 0.0)
+        rec = comps[0] if len(comps) == 1 and angle == 0.0 else combine(
+            comps[0], comps[1] if len(comps) > 1 else None, None, angle)
         if len(_RECORDS) >= _CACHE_MAX:
             _RECORDS.clear()
         _RECORDS[key] = rec
@@ -176,7 +182,8 @@ def _inputs(run) -> dict[str, Any]:  # noqa: ANN001
     return {"run_id": run.run_id, "rack": run.rack, "record": run.record,
             "im_measure": run.im_measure, "im_target": run.im_target,
             "scale_factor": run.scale_factor, "stripe": run.stripe, "mu_static": run.mu_static,
-            "mu_dynamic": run.mu_dynamic, "occupancy": run.occupancy, "seed": run.seed}
+            "mu_dynamic": run.mu_dynamic, "occupancy": run.occupancy, "seed": run.seed,
+            "angle_deg": float(getattr(run, "angle_deg", 0.0))}
 
 
 def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # noqa: ANN001
@@ -185,7 +192,8 @@ def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # n
             "pallet_peak_sliding_m": [], "n_pallets": 0, "any_fall": False, "n_fall": 0,
             "base_shear_N": nan, "beam_displacement_max_m": nan, "drift_ratio_max": nan,
             "upright_moment_connection_Nm": nan, "wall_time_s": wall,
-            **dict.fromkeys(REDUCTION_COLUMNS, nan)}
+            **dict.fromkeys(REDUCTION_COLUMNS, nan), "any_aisle_fall": False,
+            "n_aisle_fall": 0, **dict.fromkeys(DIRECTION_COLUMNS, nan)}
 
 
 def skipped_row(run, stop_im: float, rule) -> dict[str, Any]:  # noqa: ANN001
@@ -223,10 +231,25 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
                 "drift_ratio_max": float(drift.max()),
                 "upright_moment_connection_Nm": float(np.max(fp["upright_moment_connection"])),
                 **_reduction_columns(run, res, model, prepared),
+                **_direction_columns(res),
                 "wall_time_s": time.perf_counter() - t0}
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, never a stopped study
         kind = "" if isinstance(exc, SeisrackError) else f"{type(exc).__name__}: "
         return failed_row(run, f"{kind}{exc}", time.perf_counter() - t0)
+
+
+#: per-direction peak sliding columns (NaN cross-aisle on a 2D rack)
+DIRECTION_COLUMNS = ("peak_sliding_down_aisle_max_m", "peak_sliding_cross_aisle_max_m")
+
+
+def _direction_columns(res) -> dict[str, Any]:  # noqa: ANN001
+    """Falls into the aisles (3D racks; none on a 2D rack) and the peak sliding along each
+    direction."""
+    by_dir = res.pallet_peak_sliding_by_direction()
+    peak = by_dir.max(axis=0) if by_dir.size else np.zeros(by_dir.shape[1])
+    return {"any_aisle_fall": bool(res.falls), "n_aisle_fall": len(res.falls),
+            "peak_sliding_down_aisle_max_m": float(peak[0]),
+            "peak_sliding_cross_aisle_max_m": float(peak[1]) if peak.size > 1 else math.nan}
 
 
 #: columns of the sliding reduction (issue 24 item 2): this run's seismic connector and upright
@@ -239,11 +262,13 @@ REDUCTION_COLUMNS = ("connector_moment_Nm", "upright_moment_Nm", "rigid_base_she
 
 def _reduction_columns(run, res, model, prepared) -> dict[str, float]:  # noqa: ANN001
     """This run's peaks for the sliding reduction and its rigid companion's (the rigid run
-    depends on the rack, occupancy, record and scale only: one per process and key)."""
+    depends on the rack, occupancy, record, scale and incidence angle only: one per process
+    and key)."""
     from seisrack.design.sliding_reduction import response_peaks, rigid_model
 
     mine = response_peaks(res)
-    key = (run.rack_hash, run.occupancy, run.record_hash, run.scale_factor)
+    key = (run.rack_hash, run.occupancy, run.record_hash, run.scale_factor,
+           getattr(run, "angle_deg", 0.0))
     rigid = _RIGID.get(key)
     if rigid is None:
         rigid = dict.fromkeys(REDUCTION_COLUMNS[2:], math.nan)

@@ -27,7 +27,10 @@ DISTRIBUTIONS = ("lognormal", "uniform", "truncnormal")
 STOP_RULES = ("fall", "sliding")  # intensity.ida.stop_when
 DEFAULT_DT = 0.005  # s, analysis step
 DEFAULT_MAX_SCALE = 50.0  # largest scale factor accepted on a record
-_TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed")
+_TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed",
+             "angle")
+#: the distributions of a sampled incidence angle
+ANGLE_DISTRIBUTIONS = ("uniform",)
 
 
 @dataclass(frozen=True)
@@ -41,14 +44,22 @@ class EC8Suite:
     count: int = 7
     seed: int = 0
     dt: float = 0.01  # [s] record time step
+    components: int = 1  # 2: each record is a pair of horizontal components (3D racks)
 
 
 @dataclass(frozen=True)
 class RecordsSpec:
-    """Where the records come from: a folder of files, bundled records, generated suites."""
+    """Where the records come from: a folder of files, bundled records, generated suites.
+
+    pairs: the folder's files are pairs of horizontal components (3D racks): files whose
+    names differ only by their last ``_``- or ``-``-separated token form a pair, the first by
+    name down-aisle, the second cross-aisle (PEER NGA: ``RSN6_IMPVALL.I_I-ELC180.AT2`` and
+    ``...-ELC270.AT2``).
+    """
 
     folder: str | None = None  # resolved path of the folder (AT2 / CSV / TXT files)
     folder_as_given: str | None = None
+    pairs: bool = False
     units: str | None = None  # units of CSV/TXT files without a header ("g" or "m/s2")
     file_dt: float | None = None  # [s] time step of one-column files
     builtin: tuple[str, ...] = ()
@@ -129,6 +140,24 @@ class FrictionSpec:
 
 
 @dataclass(frozen=True)
+class AngleSpec:
+    """The incidence angle of the horizontal components [deg] (3D racks): a list of values,
+    or ``samples`` draws per (rack, record, occupancy) from a uniform distribution on
+    [low, high]; every run of a draw sees the same angle at every intensity level."""
+
+    kind: str = "values"
+    values: tuple[float, ...] = (0.0,)
+    low: float = 0.0
+    high: float = 0.0
+    samples: int = 1
+
+    @property
+    def turns(self) -> bool:
+        """True when some run turns the motion (an angle other than 0)."""
+        return self.kind != "values" or any(v != 0.0 for v in self.values)
+
+
+@dataclass(frozen=True)
 class StudySpec:
     """A validated study. ``racks`` are resolved paths; ``racks_as_given`` as in the file."""
 
@@ -138,6 +167,7 @@ class StudySpec:
     intensity: IntensitySpec
     friction: FrictionSpec = FrictionSpec()
     occupancy: tuple[float, ...] = (1.0,)
+    angle: AngleSpec = AngleSpec()
     dt: float = DEFAULT_DT
     seed: int = 0
     title: str = ""
@@ -187,12 +217,45 @@ def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None
     intensity = _intensity(root.table("intensity"))
     friction = _friction(root.table("friction", {"values": [0.4]}))
     occupancy = _occupancy(root.table("occupancy", {}))
+    angle = _angle(root.table("angle", {}))
     dt = root.number("dt", DEFAULT_DT, positive=True, unit="s")
     seed = root.integer("seed", 0, minimum=0)
     root.finish(_TOP_KEYS)
     return StudySpec(racks=tuple(racks), racks_as_given=tuple(racks_list), records=records,
-                     intensity=intensity, friction=friction, occupancy=occupancy, dt=dt,
-                     seed=seed, title=title, source=source, text=text)
+                     intensity=intensity, friction=friction, occupancy=occupancy, angle=angle,
+                     dt=dt, seed=seed, title=title, source=source, text=text)
+
+
+def _angle(t: Table) -> AngleSpec:
+    """``[angle]``: ``values = [deg, ...]`` or ``dist = "uniform"``, ``low``, ``high``,
+    ``samples`` (degrees, -360 to 360)."""
+    if t.has("values") and t.has("dist"):
+        raise t.error("values", t.data.get("values"), "one of 'values' (an array of angles "
+                      "[deg]) or 'dist' (\"uniform\" with low, high, samples), not both")
+
+    def degrees(v: Any, field: str) -> float:
+        x = check_number(v, field, unit="deg", source=t.source)
+        if not -360.0 <= x <= 360.0:
+            raise InputError(field, v, "an angle in degrees, -360 to 360", source=t.source)
+        return x
+
+    if t.has("dist"):
+        dist = t.string("dist")
+        if dist not in ANGLE_DISTRIBUTIONS:
+            raise t.error("dist", dist, ", ".join(f'"{d}"' for d in ANGLE_DISTRIBUTIONS))
+        low = degrees(t.raw("low", 0.0), t.field("low"))
+        high = degrees(t.raw("high"), t.field("high")) if t.has("high") else None
+        if high is None or high <= low:
+            raise t.error("high", t.data.get("high"), f"an angle > low ({low:g} deg)")
+        samples = t.integer("samples", 1, minimum=1)
+        t.finish(("dist", "low", "high", "samples"))
+        return AngleSpec(kind=dist, values=(), low=low, high=high, samples=samples)
+    raw = t.array("values", [0.0], min_len=1)
+    vals = tuple(degrees(v, f"{t.field('values')}[{i}]") for i, v in enumerate(raw))
+    if len(set(vals)) != len(vals):
+        raise t.error("values", raw, "distinct angles (an angle is listed twice)")
+    t.finish(("values",))
+    return AngleSpec(values=vals)
 
 
 def _records(t: Table, base: Path) -> RecordsSpec:
@@ -223,11 +286,17 @@ def _records(t: Table, base: Path) -> RecordsSpec:
     if not isinstance(ec8_list, list):
         raise t.error("ec8", ec8_raw, "a table or an array of tables [[records.ec8]]")
     ec8 = tuple(_ec8(Table(e, f"{t.field('ec8')}[{i}]", t.source)) for i, e in enumerate(ec8_list))
-    t.finish(("folder", "units", "dt", "builtin", "ec8"))
+    pairs = t.raw("pairs", False)
+    if not isinstance(pairs, bool):
+        raise t.error("pairs", pairs, "true or false")
+    if pairs and folder is None:
+        raise t.error("pairs", True, "pairs = true with a folder of record files (it groups "
+                      "the folder's files into pairs of horizontal components)")
+    t.finish(("folder", "units", "dt", "builtin", "ec8", "pairs"))
     if folder is None and not builtin and not ec8:
         raise t.error("<records>", {}, "at least one of folder, builtin, ec8")
-    return RecordsSpec(folder=folder, folder_as_given=folder_given, units=units, file_dt=file_dt,
-                       builtin=tuple(builtin), ec8=ec8)
+    return RecordsSpec(folder=folder, folder_as_given=folder_given, pairs=pairs, units=units,
+                       file_dt=file_dt, builtin=tuple(builtin), ec8=ec8)
 
 
 def _ec8(t: Table) -> EC8Suite:
@@ -240,8 +309,12 @@ def _ec8(t: Table) -> EC8Suite:
     s = EC8Suite(type=typ, ground=ground, ag=t.number("ag", 0.3, positive=True, unit="g"),
                  duration=t.number("duration", 10.0, positive=True, unit="s"),
                  count=t.integer("count", 7, minimum=1), seed=t.integer("seed", 0, minimum=0),
-                 dt=t.number("dt", 0.01, positive=True, unit="s"))
-    t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt"))
+                 dt=t.number("dt", 0.01, positive=True, unit="s"),
+                 components=t.integer("components", 1, minimum=1))
+    if s.components > 2:
+        raise t.error("components", s.components, "1 (one horizontal component) or 2 (a pair, "
+                      "for 3D racks)")
+    t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt", "components"))
     return s
 
 

@@ -43,6 +43,9 @@ COLUMNS = (
     ("connector_moment_Nm", "float64"), ("upright_moment_Nm", "float64"),
     ("rigid_base_shear_N", "float64"), ("rigid_connector_moment_Nm", "float64"),
     ("rigid_upright_moment_Nm", "float64"), ("rigid_alpha", "float64"),
+    # 3D racks (issue 21): the incidence angle, falls into the aisles, sliding per direction
+    ("angle_deg", "float64"), ("any_aisle_fall", "bool"), ("n_aisle_fall", "int64"),
+    ("peak_sliding_down_aisle_max_m", "float64"), ("peak_sliding_cross_aisle_max_m", "float64"),
 )
 RUNS_DIR = "runs"
 STUDY_JSON = "study.json"

@@ -50,8 +50,11 @@ DEFAULT_D_SLIDE = (0.05,)  # [m]
 PEAKS = ("peak_sliding_max_m", "n_fall", "base_shear_N", "beam_displacement_max_m",
          "drift_ratio_max", "upright_moment_connection_Nm")
 _STR = ("run_id", "rack", "record", "im_measure", "status", "error")
+#: the columns of a 3D rack's runs (NaN or False for a 2D rack's, or in an older store)
+COLUMNS_3D = ("angle_deg", "any_aisle_fall", "n_aisle_fall", "peak_sliding_down_aisle_max_m",
+              "peak_sliding_cross_aisle_max_m")
 _NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS \
-    + tuple(c for c in REDUCTION_COLUMNS if c not in PEAKS)
+    + tuple(c for c in REDUCTION_COLUMNS if c not in PEAKS) + COLUMNS_3D
 CSV_FIELDS = ("name", "theta", "beta", "theta_lo", "theta_hi", "beta_lo", "beta_hi",
               "n_stripes", "n_runs", "rack", "im_measure", "method", "status")
 
@@ -111,6 +114,16 @@ def _damage_states(d_slide, shear_capacity) -> list[tuple[str, str, float]]:
     states.append(("any_fall", "any_fall", 0.5))
     if shear_capacity is not None:
         states.append((f"base_shear>{shear_capacity:g}N", "base_shear_N", float(shear_capacity)))
+    return states
+
+
+def _damage_states_3d(d_slide) -> list[tuple[str, str, float]]:
+    """The states of a 3D rack's runs: a pallet falls into an aisle, and the sliding along
+    each direction beyond each threshold."""
+    states = [("aisle_fall", "any_aisle_fall", 0.5)]
+    for name in ("down_aisle", "cross_aisle"):
+        states += [(f"sliding_{name}>{d:g}m", f"peak_sliding_{name}_max_m", float(d))
+                   for d in d_slide]
     return states
 
 
@@ -181,20 +194,24 @@ def _stripes(r, idx, states, n_boot, seed) -> dict[str, Any]:
 
 def _ida(r, idx, states, n_boot, seed) -> dict[str, Any]:
     ok = idx[r["status"][idx] == "ok"]
-    keys = sorted({(r["record"][i], r["mu_static"][i], r["mu_dynamic"][i], r["occupancy"][i])
-                   for i in ok})
+    # an older store has no angle column (NaN): every curve at 0°
+    angle = np.nan_to_num(r["angle_deg"], nan=0.0)
+    keys = sorted({(r["record"][i], r["mu_static"][i], r["mu_dynamic"][i], r["occupancy"][i],
+                    angle[i]) for i in ok})
     curves = []
-    for rec, mu_s, mu_d, occ in keys:
-        rows = ok[(r["record"][ok] == rec) & (r["mu_static"][ok] == mu_s)
-                  & (r["mu_dynamic"][ok] == mu_d) & (r["occupancy"][ok] == occ)]
+    for rec, mu_s, mu_d, occ, ang in keys:
+        def same(rows: np.ndarray) -> np.ndarray:
+            return ((r["record"][rows] == rec) & (r["mu_static"][rows] == mu_s)  # noqa: B023
+                    & (r["mu_dynamic"][rows] == mu_d) & (r["occupancy"][rows] == occ)  # noqa: B023
+                    & (angle[rows] == ang))  # noqa: B023
+
+        rows = ok[same(ok)]
         rows = rows[np.argsort(r["im_target"][rows], kind="stable")]
-        skip = idx[(r["status"][idx] == "skipped") & (r["record"][idx] == rec)
-                   & (r["mu_static"][idx] == mu_s) & (r["mu_dynamic"][idx] == mu_d)
-                   & (r["occupancy"][idx] == occ)]
+        skip = idx[(r["status"][idx] == "skipped") & same(idx)]
         cv = {"record": rec, "mu_static": _nan(mu_s), "occupancy": _nan(occ),
-              "im": r["im_target"][rows].tolist(),
+              "angle_deg": float(ang), "im": r["im_target"][rows].tolist(),
               "stopped_im": float(r["im_target"][skip].min()) if skip.size else None}
-        for c in PEAKS + ("any_fall",):
+        for c in PEAKS + ("any_fall",) + COLUMNS_3D:
             cv[c] = [_nan(v) for v in r[c][rows]]
         curves.append(cv)
     fits = {}
@@ -249,6 +266,7 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
 
         curve = load_hazard_curve(hazard, tuple(sorted(set(r["im_measure"]))))
     states = _damage_states(d_slide, shear_capacity)
+    states_3d = _damage_states_3d(d_slide)
     status = r["status"]
     failed = status == "failed"
     reasons = Counter((e.splitlines()[0][:160] if e else "(no reason recorded)")
@@ -267,12 +285,19 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     for rack, meas in groups:
         idx = np.flatnonzero((r["rack"] == rack) & (r["im_measure"] == meas))
         g: dict[str, Any] = {"rack": rack, "im_measure": meas}
+        three_d = bool(np.isfinite(r["peak_sliding_cross_aisle_max_m"][idx]).any())
+        g_states = states + (states_3d if three_d else [])
+        if three_d:
+            g["dimension"] = "3D"
+            for name, *_ in states_3d:
+                if name not in summary["damage_states"]:
+                    summary["damage_states"].append(name)
         ms = idx[r["stripe"][idx] >= 0]
         ida = idx[r["stripe"][idx] < 0]
         if ms.size:
-            g["stripes"] = _stripes(r, ms, states, n_boot, seed)
+            g["stripes"] = _stripes(r, ms, g_states, n_boot, seed)
         if ida.size:
-            g["ida"] = _ida(r, ida, states, n_boot, seed)
+            g["ida"] = _ida(r, ida, g_states, n_boot, seed)
         red = reduction_summary(r, idx)
         if red is not None:
             g["sliding_reduction"] = red
