@@ -238,7 +238,7 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
         return failed_row(run, f"{kind}{exc}", time.perf_counter() - t0)
 
 
-#: per-direction peak sliding columns (NaN cross-aisle on a 2D rack)
+#: per-direction peak sliding columns (null cross-aisle on a 2D rack: not applicable)
 DIRECTION_COLUMNS = ("peak_sliding_down_aisle_max_m", "peak_sliding_cross_aisle_max_m")
 
 
@@ -249,7 +249,7 @@ def _direction_columns(res) -> dict[str, Any]:  # noqa: ANN001
     peak = by_dir.max(axis=0) if by_dir.size else np.zeros(by_dir.shape[1])
     return {"any_aisle_fall": bool(res.falls), "n_aisle_fall": len(res.falls),
             "peak_sliding_down_aisle_max_m": float(peak[0]),
-            "peak_sliding_cross_aisle_max_m": float(peak[1]) if peak.size > 1 else math.nan}
+            "peak_sliding_cross_aisle_max_m": float(peak[1]) if peak.size > 1 else None}
 
 
 #: columns of the sliding reduction (issue 24 item 2): this run's seismic connector and upright
