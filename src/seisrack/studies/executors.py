@@ -172,6 +172,10 @@ def _scaled(run):  # noqa: ANN001, ANN202
         angle = getattr(run, "angle_deg", 0.0)
         rec = comps[0] if len(comps) == 1 and angle == 0.0 else combine(
             comps[0], comps[1] if len(comps) > 1 else None, None, angle)
+        if not isinstance(rec, Record) and _CTX.racks[run.rack_hash].ndm == 2:
+            # a warehouse's 2D row: the motion along its down-aisle axis
+            rec = Record(rec.x, rec.dt, name=comps[0].name,
+                         provenance=f"{comps[0].provenance}, along a row at {-angle:g} deg")
         if len(_RECORDS) >= _CACHE_MAX:
             _RECORDS.clear()
         _RECORDS[key] = rec

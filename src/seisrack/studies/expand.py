@@ -102,7 +102,7 @@ def plan(spec: StudySpec) -> StudyPlan:
     runs: list[Run] = []
     intensity = spec.intensity
     levels = intensity.levels
-    for given, rh in rack_keys:
+    for r_index, (given, rh) in enumerate(rack_keys):
         rack = racks[rh]
         for occ in spec.occupancy:
             kept = _pattern(len(rack.pallets), occ, spec.seed, rh)
@@ -114,7 +114,9 @@ def plan(spec: StudySpec) -> StudyPlan:
                 im0 = float(np.exp(np.mean([np.log(_intensity_of(
                     c, intensity.measure, period, intensity.damping)) for c in comps])))
                 _check_reachable(name, comps[0], im0, levels, intensity, spec.dt, period)
-                for angle in _angle_samples(spec, rh, rec_h, occ):
+                angles = (spec.rack_angles[r_index] if spec.rack_angles
+                          else _angle_samples(spec, rh, rec_h, occ))
+                for angle in angles:
                     for mu_s in _friction_samples(spec, rh, rec_h, occ):
                         mu_d = mu_s * spec.friction.dynamic_ratio
                         for k, target in enumerate(levels):
@@ -250,9 +252,13 @@ def _pairs(read: dict, spec: StudySpec) -> list[tuple[str, tuple[Record, ...]]]:
 
 
 def _check_dimensions(spec: StudySpec, racks: dict, records: list) -> None:
-    """Pairs of components and an incidence angle need 3D racks (the feature table)."""
+    """Pairs of components and an incidence angle need 3D racks (the feature table). A
+    warehouse's 2D rows take the motion along their down-aisle axis (the executor projects it),
+    so a warehouse is not checked."""
     from seisrack.model.features import require
 
+    if spec.warehouse is not None:
+        return
     two = next((n for n, _, comps in records if len(comps) == 2), None)
     for rack in racks.values():
         if two is not None:

@@ -28,7 +28,7 @@ STOP_RULES = ("fall", "sliding")  # intensity.ida.stop_when
 DEFAULT_DT = 0.005  # s, analysis step
 DEFAULT_MAX_SCALE = 50.0  # largest scale factor accepted on a record
 _TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed",
-             "angle")
+             "angle", "warehouse")
 #: the distributions of a sampled incidence angle
 ANGLE_DISTRIBUTIONS = ("uniform",)
 
@@ -173,6 +173,10 @@ class StudySpec:
     title: str = ""
     source: str | None = None
     text: str = ""  # the study file as given (stored in study.json)
+    warehouse: Any = None  # a Warehouse (seisrack.studies.warehouse) instead of ``racks``
+    warehouse_as_given: str | None = None
+    #: per rack, the incidence angles [deg] of its warehouse rows (overrides ``angle``)
+    rack_angles: tuple[tuple[float, ...], ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -197,6 +201,8 @@ def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None
     base = Path(base)
     root = Table(d, "", source)
     title = root.string("title", "")
+    if root.has("warehouse"):
+        return _warehouse_study(root, d, base, source, text, title)
     racks_raw = root.raw("racks")
     racks_list = [racks_raw] if isinstance(racks_raw, str) else racks_raw
     if not isinstance(racks_list, list) or not racks_list or not all(
@@ -224,6 +230,43 @@ def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None
     return StudySpec(racks=tuple(racks), racks_as_given=tuple(racks_list), records=records,
                      intensity=intensity, friction=friction, occupancy=occupancy, angle=angle,
                      dt=dt, seed=seed, title=title, source=source, text=text)
+
+
+def _warehouse_study(root: Table, d: Any, base: Path, source: str | None, text: str,
+                     title: str) -> StudySpec:
+    """A study of every rack row of a warehouse file (``warehouse = "site.toml"`` instead of
+    ``racks``): each group of rows is a rack run at its orientation (docs/user/
+    warehouse_toml.md); identical rows of a group see the same ground motion."""
+    from seisrack.studies.warehouse import load_warehouse
+
+    given = root.string("warehouse")
+    for key in ("racks", "angle"):
+        if root.has(key):
+            raise root.error(key, d[key], f"no '{key}' with 'warehouse' (the warehouse file "
+                             "gives the racks and their orientations)")
+    wp = base / given if not Path(given).is_absolute() else Path(given)
+    if not wp.is_file():
+        raise root.error("warehouse", given, f"an existing warehouse TOML file (looked for {wp})")
+    wh = load_warehouse(wp)
+    racks: list[str] = []  # as given in the warehouse file (labels of the runs)
+    paths: dict[str, str] = {}
+    angles: dict[str, list[float]] = {}
+    for row in wh.rows:
+        if row.rack_as_given not in angles:
+            racks.append(row.rack_as_given)
+            paths[row.rack_as_given] = str(Path(row.rack).resolve())
+            angles[row.rack_as_given] = []
+        # the motion in the rack's axes is the record pair turned by -orientation
+        a = -float(row.orientation_deg) + 0.0
+        if a not in angles[row.rack_as_given]:
+            angles[row.rack_as_given].append(a)
+    inner = {k: v for k, v in d.items() if k not in ("warehouse", "title")}
+    spec = study_from_dict({**inner, "racks": [paths[r] for r in racks],
+                            "title": title or wh.title}, base=base, source=source, text=text)
+    from dataclasses import replace
+
+    return replace(spec, racks_as_given=tuple(racks), warehouse=wh, warehouse_as_given=given,
+                   rack_angles=tuple(tuple(angles[r]) for r in racks))
 
 
 def _angle(t: Table) -> AngleSpec:

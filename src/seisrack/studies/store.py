@@ -160,6 +160,15 @@ def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa
                                         if spec.intensity.ida_stop else None)},
         "runs": [asdict(r) for r in runs],
     }
+    wh = getattr(spec, "warehouse", None)
+    if wh is not None:
+        doc["warehouse"] = {"file": spec.warehouse_as_given, "path": wh.source,
+                            "title": wh.title,
+                            "groups": [{"name": r.name, "rack": r.rack_as_given, "count": r.count,
+                                        "orientation_deg": r.orientation_deg,
+                                        "angle_deg": -float(r.orientation_deg) + 0.0,
+                                        "n_pallets": r.n_pallets, "three_d": r.three_d}
+                                       for r in wh.rows]}
     path = out / STUDY_JSON
     tmp = out / f".{STUDY_JSON}.{os.getpid()}.tmp"
     tmp.write_text(json.dumps(doc, indent=1, allow_nan=True))

@@ -312,6 +312,15 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         from seisrack.studies.risk import risk_summary
 
         summary["risk"] = {"file": str(hazard), **risk_summary(curve, summary["fragility"])}
+    from seisrack.studies.warehouse_summary import warehouse_groups, warehouse_summary
+
+    wh = warehouse_groups(out)
+    if wh is not None:
+        summary["warehouse"] = {**warehouse_summary(r, wh), "path": wh.get("path")}
+        if hazard is not None:
+            from seisrack.studies.warehouse_summary import annual_falls
+
+            summary["warehouse"]["per_year"] = annual_falls(summary["warehouse"], curve)
     if boots is not None:
         boots.extend(boot_store)
     if write:
@@ -330,6 +339,11 @@ def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None
             w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in w.fieldnames})
     if plots:
         files.update(_figures(folder, summary, boots))
+        if "warehouse" in summary:
+            from seisrack.studies.warehouse_summary import plan_figures
+
+            files.update(plan_figures(folder, summary["warehouse"],
+                                      summary["warehouse"].get("path")))
     summary["files"] = files
     (folder / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1,
                                                     allow_nan=False))
@@ -446,6 +460,10 @@ def format_summary(s: dict[str, Any]) -> str:
         from seisrack.studies.risk import format_risk
 
         lines += format_risk(s["risk"])
+    if "warehouse" in s:
+        from seisrack.studies.warehouse_summary import format_warehouse
+
+        lines += format_warehouse(s["warehouse"])
     if "files" in s:
         lines.append("\nwritten: " + ", ".join(s["files"].values()))
     return "\n".join(lines)

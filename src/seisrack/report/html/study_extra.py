@@ -1,7 +1,9 @@
-"""Sections of the study report for issue 24: the sliding reduction and the risk per year.
+"""Sections of the study report for issue 24: the sliding reduction, the risk per year and the
+warehouse.
 
-Built from the study's ``summary.json`` (``groups[i].sliding_reduction``, ``risk``); every
-number cell carries its value and its place there (``data-path``), as the rest of the page.
+Built from the study's ``summary.json`` (``groups[i].sliding_reduction``, ``risk``,
+``warehouse``); every number cell carries its value and its place there (``data-path``), as the
+rest of the page.
 """
 
 from __future__ import annotations
@@ -10,25 +12,11 @@ from typing import Any
 
 from seisrack.report.html import figures as F
 from seisrack.report.html.page import _figure
-from seisrack.report.html.tables import esc, num_cell
+from seisrack.report.html.study_page import _cell, _table
+from seisrack.report.html.tables import esc
 
 G = 9.80665  # [m/s²]
 _Q = ("base_shear", "connector_moment", "upright_moment")
-
-
-def _cell(path: list[Any], value: Any, factor: float = 1.0, fmt: str = "{:.4g}") -> str:
-    import json
-
-    dp = f'data-path="{esc(json.dumps(path))}"'
-    if value is None:
-        return f'<td class="num" {dp} data-value="null">–</td>'
-    return num_cell(value, factor, fmt, str(path[-1])).replace("<td ", f"<td {dp} ", 1)
-
-
-def _table(tid: str, headers: list[str], rows: list[str], caption: str) -> str:
-    head = "".join(f"<th>{esc(h)}</th>" for h in headers)
-    return (f'<table id="{esc(tid)}"><caption>{esc(caption)}</caption><thead><tr>{head}</tr>'
-            f"</thead><tbody>{''.join(rows)}</tbody></table>")
 
 
 def reduction_section(summary: dict[str, Any], number: int) -> str:
@@ -116,3 +104,54 @@ def risk_section(summary: dict[str, Any], number: int) -> str:
                       "(right axis) with the FEMA P-58 storage-rack fragility (dashed), "
                       "against the intensity [m/s²].")
             + "</section>")
+
+
+def warehouse_section(summary: dict[str, Any], number: int) -> str:
+    """``<section id="warehouse">`` or "" for a study of racks (``warehouse = ...``)."""
+    wh = summary.get("warehouse")
+    if not wh:
+        return ""
+    rows = []
+    for li, lv in enumerate(wh["levels"]):
+        for gi, g in enumerate(lv["groups"]):
+            base = ["warehouse", "levels", li, "groups", gi]
+            rows.append("<tr>" + (_cell(["warehouse", "levels", li, "im"], lv["im"], 1 / G,
+                                        "{:.3f}") if gi == 0 else "<td></td>")
+                        + f"<td>{esc(g['group'])}</td><td>{g['rows']}</td><td>{g['runs']}</td>"
+                        + _cell(base + ["mean_per_row"], g["mean_per_row"], 1, "{:.3g}")
+                        + _cell(base + ["p_row_loses_a_pallet"], g["p_row_loses_a_pallet"], 1,
+                                "{:.2f}")
+                        + _cell(base + ["expected"], g["expected"], 1, "{:.3g}")
+                        + f"<td>{esc(g['what'])}</td></tr>")
+        rows.append("<tr class=\"total\"><td></td><td>warehouse</td><td></td><td></td><td></td>"
+                    "<td></td>" + _cell(["warehouse", "levels", li, "expected_falls"],
+                                        lv["expected_falls"], 1, "{:.3g}")
+                    + f"<td>driven by {esc(', '.join(lv['driven_by']) or 'no group')}</td></tr>")
+    per_year = wh.get("per_year") or {}
+    year = ""
+    if per_year.get("expected_per_year") is not None:
+        year = (f"<p>On the site hazard curve: <b>{per_year['expected_per_year']:.3g}</b> falling "
+                f"pallets per year ({per_year['expected_in_50_years']:.3g} in 50 years), each "
+                "stripe standing for the intensities between the geometric midpoints to its "
+                f"neighbours; {100 * per_year['top_bin_share']:.0f} % comes from motions "
+                "stronger than the highest stripe's bin, counted at the highest stripe "
+                "(FEMA P-58-1 §8.2).</p>")
+    figs = ""
+    path = wh.get("path")
+    if path:
+        from seisrack.studies.warehouse_summary import plan_axes
+
+        for li, ax in enumerate(plan_axes(wh, path)):
+            figs += _figure(f"fig-warehouse-{li}", F.png_data_uri(ax.figure),
+                            f"Plan at IM {wh['levels'][li]['im'] / G:.3f} g: each row coloured "
+                            "by the probability that it loses a pallet (arrow: down-aisle).")
+    return (f'<section id="warehouse"><h2>{number}. The warehouse</h2>'
+            f"<p>{wh['n_rows']} rows, {wh['n_pallets']} pallets ({esc(wh.get('file', ''))}). "
+            "Identical rows see the same motion; a group's expected falls are its number of "
+            "rows times the mean over the runs of the level. A 3D row counts the pallets "
+            "falling into an aisle; a 2D row, which has no cross-aisle, the pallets whose "
+            "down-aisle sliding reached their free distance.</p>"
+            + _table("table-warehouse", ["IM [g]", "group", "rows", "runs", "falls per row",
+                                         "P(row loses a pallet)", "expected falls", "what"],
+                     rows, "Expected number of falling pallets per intensity level.")
+            + year + figs + "</section>")

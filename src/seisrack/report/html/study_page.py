@@ -360,9 +360,14 @@ def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = 
     if ida:
         sec.append('<section id="ida"><h2>6. Incremental dynamic analysis</h2>'
                    + "".join(ida) + "</section>")
-    from seisrack.report.html.study_extra import reduction_section, risk_section
+    from seisrack.report.html.study_extra import (
+        reduction_section,
+        risk_section,
+        warehouse_section,
+    )
 
-    sec += [s for s in (reduction_section(summary, 7), risk_section(summary, 8)) if s]
+    sec += [s for s in (reduction_section(summary, 7), risk_section(summary, 8),
+                        warehouse_section(summary, 9)) if s]
     line = (f"{summary.get('runs_total')} runs, {summary.get('runs_ok')} ok, "
             f"{summary.get('runs_failed')} failed.")
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
