@@ -15,7 +15,7 @@ Checked, against independent arithmetic or a direct run:
 - on a power-law hazard curve the expected falls per year are Σ E_i·ΔH_i over bins with edges at
   the geometric midpoints, by hand (FEMA P-58-1 2012 §8.2);
 - the summary writes one plan figure per level, its JSON and an HTML section; a second run
-  resumes (no new runs).
+  resumes (no new runs); a Dask LocalCluster gives the same table.
 """
 
 from __future__ import annotations
@@ -251,3 +251,14 @@ def test_cli_summary_with_a_hazard_gives_falls_per_year(stored, tmp_path: Path) 
     html = (tmp_path / "study.html").read_text()
     assert '<section id="warehouse">' in html and 'id="table-warehouse"' in html
     assert html.count('id="fig-warehouse-') == 2 and "falling pallets per year" in html
+
+
+def test_dask_gives_the_same_table(stored, tmp_path: Path) -> None:
+    pytest.importorskip("dask.distributed")
+    path, _, rows = stored
+    run_study(load_study(path), tmp_path, executor="dask", workers=2, batch_size=3,
+              progress=False)
+    other = read_runs(tmp_path).drop_columns(["wall_time_s"]).to_pylist()
+    key = lambda r: r["run_id"]  # noqa: E731
+    mine = [{k: v for k, v in r.items() if k != "wall_time_s"} for r in rows]
+    assert sorted(other, key=key) == sorted(mine, key=key)
