@@ -199,7 +199,12 @@ def _design_lines(design: dict[str, Any] | None,
             ("beam end shear", "beam_end_shear_N", 1e-3, "kN"),
             ("connector moment", "connector_moment_Nm", 1e-3, "kN·m"),
             ("connector rotation", "connector_rotation_rad", 1e3, "mrad"),
-            ("upright axial force", "upright_axial_force_N", 1e-3, "kN")]
+            ("upright axial force", "upright_axial_force_N", 1e-3, "kN"),
+            # 3D racks: the cross-aisle twins (absent in 2D, skipped)
+            ("interstorey drift ratio cross-aisle", "interstorey_drift_ratio_cross_aisle",
+             1e2, "%"),
+            ("upright moment cross-aisle", "upright_moment_section_cross_aisle_Nm", 1e-3,
+             "kN·m")]
     out = ["", "Design quantities (gravity + seismic, elastic; member of the peak)"]
     for name, key, scale, unit in rows:
         item = design.get(key) or {}

@@ -150,7 +150,9 @@ def _peaks(r: dict[str, np.ndarray], idx: np.ndarray) -> dict[str, Any]:
     recs = r["record"][idx]
     names = sorted(set(recs))
     out: dict[str, Any] = {}
-    for c in PEAKS:
+    extra = tuple(c for c in ("n_aisle_fall", "peak_sliding_cross_aisle_max_m")
+                  if c in r and np.any(np.isfinite(r[c][idx].astype(float))))  # 3D racks
+    for c in PEAKS + extra:
         per_rec = np.array([np.nanmean(r[c][idx][recs == nm]) if np.any(
             np.isfinite(r[c][idx][recs == nm])) else math.nan for nm in names])
         per_rec = per_rec[np.isfinite(per_rec)]
@@ -424,14 +426,19 @@ def format_summary(s: dict[str, Any]) -> str:
     for g in s["groups"]:
         lines.append(f"\nrack {g['rack']}, IM = {g['im_measure']} [m/s²]")
         if "stripes" in g:
-            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  falls (mean)")
+            three_d = g.get("dimension") == "3D"
+            # at risk: down-aisle sliding reached the free distance (pallets_at_risk)
+            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  at risk (mean)"
+                         + ("  fell into an aisle (mean)" if three_d else ""))
             for st in g["stripes"]["stripes"]:
                 pk = st["peaks"]["peak_sliding_max_m"]
                 nf = st["peaks"]["n_fall"]
+                na = st["peaks"].get("n_aisle_fall") or {"mean": None}
                 lines.append(f"  {st['stripe']:6d} {st['im']:7.3g} "
                              f"{st['n_ok']:4d}/{st['n_runs']:<4d} {st['n_records']:7d}  "
                              f"{_fmt(pk['mean']):>9} / {_fmt(pk['max']):<9}"
-                             f" {_fmt(nf['mean'])}")
+                             f" {_fmt(nf['mean']):>14}"
+                             + (f"  {_fmt(na['mean']):>26}" if three_d else ""))
         if "ida" in g:
             lines.append(f"  IDA: {len(g['ida']['curves'])} curves")
         if "sliding_reduction" in g:
