@@ -161,10 +161,12 @@ def format_design(res: Any, title: str = "") -> str:
     if members:
         L.append("\nmembers (largest |gravity| + seismic; seismic part combined over modes "
                  "and directions)")
+        wn = max(len(q.name) for q in members)
+        wl = max(len(q.governing[0]) for q in members)
         for q in members:
             lab, val = q.governing
             k = q.labels.index(lab)
-            L.append(f"  {q.name:<20} {val:>11.4g} {q.unit:<4} at {lab:<14} (gravity "
+            L.append(f"  {q.name:<{wn}} {val:>11.4g} {q.unit:<4} at {lab:<{wl}} (gravity "
                      f"{q.gravity[k]:.4g}, seismic {q.seismic[k]:.4g})")
     L.append("\nfactors (override with --factors KEY=VALUE):")
     for k, v in res.factors.items():
