@@ -255,14 +255,16 @@ def _check_stable(K: sp.csr_matrix, spec: RackSpec) -> None:
 def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matrix,
              r_y: FloatArray) -> tuple[sp.csr_matrix, float]:
     """K_E + K_G and the critical load factor; InputError if the gravity load buckles the rack.
+    A plane or a space rack (members in both bending planes, bracing bars included:
+    :mod:`seisrack.fe.geometric`).
 
     Gravity load F = -g·M·r_y: with the consistent member mass this is the consistent load
     vector of the members' self weight (a rigid vertical translation is exact in the element's
     shape functions), plus each pallet's weight on its support nodes' uy DOFs.
     """
     form = spec.second_order.form
-    N = geometric.gravity_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
-    K_G = geometric.geometric_stiffness(mesh, N, form)
+    N, N_bar = geometric.static_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
+    K_G = geometric.geometric_stiffness(mesh, N, form, N_bar)  # bars: their string stiffness
     lam = geometric.critical_load_factor(K_E, K_G)
     if lam <= 1.0:
         raise InputError(
