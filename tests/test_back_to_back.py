@@ -4,7 +4,7 @@ spacers, pallets on each row, falls into either aisle or the flue.
 References:
 - Two rows with the spacers removed are two copies of the single row: every period of the
   single row appears twice (an exact property of a block-diagonal eigenproblem; measured
-  3.5e-14 on ``examples/warehouse_rack_3d_b2b.toml`` and below 1e-13 here).
+  3.5e-14 on ``examples/warehouse_rack_3d_b2b.toml`` and 2.6e-13 on the two-row paper rack here).
 - OpenSeesPy, the rack exported by ``seisrack export opensees``: the first ten periods of
   ``examples/warehouse_rack_3d_b2b.toml`` equal seisrack's within 1e-8 (measured 7.7e-13).
   The peer built member by member from the geometry in ``tests/test_model_3d_opensees.py``
