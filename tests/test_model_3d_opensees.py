@@ -43,9 +43,10 @@ def _sections(ip_equals_j: bool = True) -> dict:
 
 
 def _rack(pattern="Z", *, levels=(2.0,), bays=(1.8, 1.8), base_cross=None, spine=False,
-          joint=160e3, base=160e3, ip_equals_j=True) -> dict:
-    pallets = [{"mass": 400.0, "bay": b, "level": lev, "position": x, "mu_static": 0.6,
-                "mu_dynamic": 0.6, "depth": 1.2, "overhang": 0.05}
+          joint=160e3, base=160e3, ip_equals_j=True, rows=1) -> dict:
+    pallets = [{"mass": 400.0 - 100.0 * (r - 1), "bay": b, "level": lev, "position": x,
+                "mu_static": 0.6, "mu_dynamic": 0.6, "depth": 1.2, "overhang": 0.05, "row": r}
+               for r in range(1, rows + 1)
                for lev in range(1, len(levels) + 1) for b in range(1, len(bays) + 1)
                for x in (0.45, 1.35)]
     d = {"material": {"E": E, "density": RHO, "poisson": NU},
@@ -58,6 +59,10 @@ def _rack(pattern="Z", *, levels=(2.0,), bays=(1.8, 1.8), base_cross=None, spine
          "pallets": pallets}
     if base_cross is not None:
         d["connections"]["base_cross"] = base_cross
+    if rows == 2:  # back to back: spacers 0.3 m long at 0.7 and 2.0 m
+        d["sections"]["spacer"] = {"A": 304e-6}
+        d["geometry"].update(rows=2, row_spacer={"length": 0.3, "section": "spacer",
+                                                 "heights": [0.7, 2.0]})
     if spine:
         d["bracing"].update(spine=True, spine_section="spine", spine_bays=[1])
     return d
@@ -149,6 +154,9 @@ CASES = {
     # seisrack's default twist inertia (Ip = Iy + Iz) against OpenSees' (ρ J L / 3):
     # the member twist inertia barely matters for the rack's modes (measured 5e-5)
     "paper_Z_default_Ip": {"ip_equals_j": False},
+    # back-to-back rows (issue 21): the spacers are bars between the rows' inner uprights, the
+    # second row carries lighter pallets (300 kg) so the rows are not twins
+    "two_rows": {"rows": 2, "spine": True},
 }
 
 

@@ -115,8 +115,10 @@ def test_falls_are_first_crossings_of_the_overhang(falling):
     t, u = resp.t, resp.pallet_sliding
     for f in resp.falls:
         uz = u[:, f.pallet, 1]
-        limit = resp.fall_front[f.pallet] if f.side == "front" else resp.fall_rear[f.pallet]
-        sign = -1.0 if f.side == "front" else 1.0
+        assert f.side in ("front aisle", "rear aisle") and f.into_aisle  # one row: two aisles
+        front = f.side == "front aisle"
+        limit = resp.fall_front[f.pallet] if front else resp.fall_rear[f.pallet]
+        sign = -1.0 if front else 1.0
         before = t < f.time_s - resp.dt
         assert np.all(sign * uz[before] < limit)
         k = np.searchsorted(t, f.time_s)

@@ -2,12 +2,13 @@
 :mod:`seisrack.model.pallet_layout`).
 
 A pallet of a 3D rack *falls* cross-aisle the first time its sliding passes its fall distance
-towards the front aisle (−z) or the rear (+z). A down-aisle *impact* is the first time a gap
-closes between two neighbouring pallets, or between an end pallet and its upright; it is
-reported with its closing speed. Crossing times are interpolated linearly between samples. The
-run does not follow a pallet beyond either event (it stays on its beams in the model), so what
-happens to a pallet after its fall or impact is not physical: the tracker reports first
-occurrences only.
+towards −z or +z: into the front aisle, the flue of a back-to-back rack or the rear aisle
+(:meth:`~seisrack.model.pallet_layout.PalletLayout.fall_side`). A down-aisle *impact* is the
+first time a gap closes between two neighbouring pallets, or between an end pallet and its
+upright; it is reported with its closing speed. Crossing times are interpolated linearly
+between samples. The run does not follow a pallet beyond either event (it stays on its beams in
+the model), so what happens to a pallet after its fall or impact is not physical: the tracker
+reports first occurrences only.
 """
 
 from __future__ import annotations
@@ -16,17 +17,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from seisrack.model.pallet_layout import UPRIGHT, PalletLayout
+from seisrack.model.pallet_layout import FLUE, UPRIGHT, PalletLayout
 
 
 @dataclass(frozen=True)
 class Fall:
-    """Pallet ``pallet`` (0-based) falls towards ``side`` ("front" aisle, −z, or "rear", +z)
-    at ``time_s``."""
+    """Pallet ``pallet`` (0-based) falls at ``time_s`` into ``side``: "front aisle" (−z),
+    "flue" (between the rows of a back-to-back rack) or "rear aisle" (+z)."""
 
     pallet: int
     time_s: float
     side: str
+
+    @property
+    def into_aisle(self) -> bool:
+        """True for a fall into either aisle (the falls that hurt people), False into the
+        flue."""
+        return self.side != FLUE
 
 
 @dataclass(frozen=True)
@@ -115,7 +122,7 @@ class ContactTracker:
     def falls(self) -> list[Fall]:
         idx = np.flatnonzero(np.isfinite(self.fall_time))
         out = [Fall(int(p), float(self.fall_time[p]),
-                    "front" if self.fall_side[p] < 0 else "rear") for p in idx]
+                    self.layout.fall_side(int(p), int(self.fall_side[p]))) for p in idx]
         return sorted(out, key=lambda f: f.time_s)
 
     def impacts(self) -> list[Impact]:

@@ -322,4 +322,5 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
         level_y=np.asarray(model.level_y), fall_front=np.asarray(lay.fall_front),
         fall_rear=np.asarray(lay.fall_rear), falls=tuple(contacts.falls()),
         impacts=tuple(contacts.impacts()),
+        pallet_row=np.asarray(model.pallet_row) if model.n_rows > 1 else None,
     )

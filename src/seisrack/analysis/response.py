@@ -111,6 +111,7 @@ class RackResponse:
     fall_rear: np.ndarray | None = None
     falls: tuple[Fall, ...] = ()
     impacts: tuple[Impact, ...] = ()
+    pallet_row: np.ndarray | None = None  # (m,) 0-based, back-to-back racks only
 
     # ------------------------------------------------------------------ shapes
     @property
@@ -151,10 +152,13 @@ class RackResponse:
 
     def pallet_labels(self) -> list[str]:
         """Readable label of each pallet, ``"L{level}-B{bay}-S{slot}"`` (all 1-based; slot =
-        position within the bay and level, left to right)."""
+        position within the bay and level, left to right), ``"R{row}-L…"`` on a back-to-back
+        rack (as :meth:`~seisrack.model.frame_model.FrameModel.pallet_labels`)."""
         bay, slot = self._bay(), self._slot()
-        return [f"L{int(self.pallet_level[j]) + 1}-B{int(bay[j]) + 1}-S{int(slot[j]) + 1}"
-                for j in range(self.n_pallets)]
+        row = [""] * self.n_pallets if self.pallet_row is None else \
+            [f"R{int(r) + 1}-" for r in self.pallet_row]
+        return [f"{row[j]}L{int(self.pallet_level[j]) + 1}-B{int(bay[j]) + 1}-"
+                f"S{int(slot[j]) + 1}" for j in range(self.n_pallets)]
 
     def _sliding_extremes(self) -> tuple[np.ndarray, np.ndarray]:
         """(m, n_dir), (m, n_dir) [m] largest and smallest sliding over every analysis step."""
@@ -339,7 +343,9 @@ class RackResponse:
         for j, lab in enumerate(self.pallet_labels()):
             row = {
                 "id": j + 1, "label": lab, "level": int(self.pallet_level[j]) + 1,
-                "bay": int(self._bay()[j]) + 1, "x_m": float(self.pallet_x[j]),
+                "bay": int(self._bay()[j]) + 1,
+                **({} if self.pallet_row is None else {"row": int(self.pallet_row[j]) + 1}),
+                "x_m": float(self.pallet_x[j]),
                 "mass_kg": float(self.pallet_mass[j]),
                 "mu_static": float(self.pallet_mu_static[j]),
                 "mu_dynamic": float(self.pallet_mu_dynamic[j]),
@@ -406,6 +412,7 @@ class RackResponse:
             "angle_deg": self.angle_deg,
             "pallets_checked_for_falls": int(np.sum(np.isfinite(self.fall_front))),
             "pallets_falling": len(self.falls),
+            "pallets_falling_into_aisle": sum(1 for f in self.falls if f.into_aisle),
             "falls_by_level": by_level,
             "falls": [{"pallet": f.pallet + 1, "label": self.pallet_labels()[f.pallet],
                        "level": int(self.pallet_level[f.pallet]) + 1,

@@ -283,7 +283,8 @@ class DesignOperators:
             shear force [N] (``V_i`` at the left end, ``-V_j`` at the right end, the same
             internal shear sign on both ends) at the two ends of every beam, level by level,
             bay by bay (front then rear beam in 3D), left end then right end.
-            ``beam_labels``: ``"L{l}-B{b}-left"`` (2D), ``"L{l}-B{b}-front-left"`` (3D).
+            ``beam_labels``: ``"L{l}-B{b}-left"`` (2D), ``"L{l}-B{b}-front-left"`` (3D),
+            ``"L{l}-B{b}-R{r}-front-left"`` (back-to-back rows).
         connector_rotation, connector_moment: (n_dof, n_conn) relative rotation [rad] of each
             beam-to-upright spring and its moment ``k·rotation`` [N·m], signed like the beam
             end moment it carries (left end: beam minus upright rotation, right end: upright
@@ -306,10 +307,22 @@ class DesignOperators:
     axial_labels: tuple[str, ...]
 
 
+def side_names(n_side: int) -> tuple[str, ...]:
+    """Label suffix of each upright side: ``("",)`` (2D), ``("-front", "-rear")`` (a 3D rack
+    of one row), ``("-R1-front", "-R1-rear", "-R2-front", "-R2-rear")`` (back to back)."""
+    if n_side == 1:
+        return ("",)
+    one = ("-front", "-rear")
+    if n_side == 2:
+        return one
+    return tuple(f"-R{r + 1}{s}" for r in range(n_side // 2) for s in one)
+
+
 def column_labels(model: Any) -> tuple[str, ...]:
-    """Upright column names: ``"U{line}"`` (2D), ``"U{line}-front"`` / ``"-rear"`` (3D)."""
-    sides = ("", "-front", "-rear") if int(np.max(model.column_side, initial=0)) else ("",)
-    return tuple(f"U{int(ln) + 1}" + (sides[int(s) + 1] if len(sides) > 1 else "")
+    """Upright column names: ``"U{line}"`` (2D), ``"U{line}-front"`` / ``"-rear"`` (3D),
+    ``"U{line}-R{row}-front"`` … (back-to-back rows)."""
+    names = side_names(int(np.max(model.column_side, initial=0)) + 1)
+    return tuple(f"U{int(ln) + 1}{names[int(s)]}"
                  for ln, s in zip(model.column_line, model.column_side, strict=True))
 
 
@@ -345,7 +358,7 @@ def design_operators(model: Any) -> DesignOperators:
     sign = np.tile([-1.0, 1.0], n_ends // 2)
     beam_m = _end_rows(kt, edofs, ends, comp_m, sign, n)
     beam_v = _end_rows(kt, edofs, ends, comp_v, -sign, n)
-    side_name = ("",) if n_side == 1 else ("-front", "-rear")
+    side_name = side_names(n_side)
     beam_labels = tuple(f"L{lv + 1}-B{b + 1}{side_name[s]}-{e}" for lv in range(n_lev)
                         for b in range(n_bay) for s in range(n_side) for e in ("left", "right"))
 

@@ -51,13 +51,14 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     nd = mesh.node_dofs
 
     n_p = len(spec.pallets)
-    p_node = np.array([[_support_node(rm, p.level - 1, p.bay - 1, side, p.position)
-                        for side in range(rm.n_side)] for p in spec.pallets],
-                      dtype=np.int64).reshape(n_p, rm.n_side)
+    k = rm.n_side // spec.geometry.rows  # supports of a pallet: the beams of its row
+    p_node = np.array([[_support_node(rm, p.level - 1, p.bay - 1, k * (p.row - 1) + side,
+                                      p.position) for side in range(k)]
+                       for p in spec.pallets], dtype=np.int64).reshape(n_p, k)
     p_dofs = nd[p_node][:, :, list(slots)]
     p_vdof = nd[p_node, 1]
     p_mass = np.array([p.mass for p in spec.pallets], dtype=float)
-    share = np.repeat(p_mass / rm.n_side, rm.n_side)
+    share = np.repeat(p_mass / k, k)
     M = symmetric_csr(M + _diagonal(p_vdof.ravel(), share, mesh.n_dof))  # vertical mass
 
     r_x, r_y = _influence(nd[:, 0], mesh.n_dof), _influence(nd[:, 1], mesh.n_dof)
@@ -82,8 +83,9 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         pallet_friction_rate=np.array([p.friction_rate for p in spec.pallets], dtype=float),
         pallet_level=np.array([p.level - 1 for p in spec.pallets], dtype=np.int64),
         pallet_bay=np.array([p.bay - 1 for p in spec.pallets], dtype=np.int64),
-        pallet_slot=_slots(spec), pallet_x=np.asarray(mesh.nodes[p_node[:, 0], 0], dtype=float)
-        if n_p else np.zeros(0),
+        pallet_slot=_slots(spec),
+        pallet_row=np.array([p.row - 1 for p in spec.pallets], dtype=np.int64),
+        pallet_x=np.asarray(mesh.nodes[p_node[:, 0], 0], dtype=float) if n_p else np.zeros(0),
         pallet_depth=_optional(spec, "depth"), pallet_overhang=_optional(spec, "overhang"),
         layout=pallet_layout(spec),
         level_dofs=tuple(_level_dofs(rm, spec, s) for s in slots),
@@ -95,7 +97,8 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         level_nodes=rm.level_nodes, upright_base_elements=rm.upright_base_elements,
         upright_below_elements=rm.upright_below_elements,
         upright_above_elements=rm.upright_above_elements, member_mass=mesh.member_mass,
-        g=spec.g, title=spec.title, critical_load_factor=lam_cr,
+        g=spec.g, title=spec.title, critical_load_factor=lam_cr, n_rows=spec.geometry.rows,
+        frame_z=np.array(spec.geometry.frame_z),
         **_hinges(spec, mesh, K, M, r_y),
     ))
 
@@ -167,12 +170,12 @@ def _check_gravity_elastic(spec: RackSpec, th_g: FloatArray, k: FloatArray, base
 
 
 def _slots(spec: RackSpec) -> np.ndarray:
-    """(m,) 0-based position of each pallet within its (level, bay), left to right (ties in
-    input order)."""
+    """(m,) 0-based position of each pallet within its (row, level, bay), left to right (ties
+    in input order)."""
     slot = np.zeros(len(spec.pallets), dtype=np.int64)
     for j, p in enumerate(spec.pallets):
         slot[j] = sum(1 for i, q in enumerate(spec.pallets)
-                      if q.level == p.level and q.bay == p.bay
+                      if q.level == p.level and q.bay == p.bay and q.row == p.row
                       and (q.position < p.position or (q.position == p.position and i < j)))
     return slot
 
@@ -255,14 +258,16 @@ def _check_stable(K: sp.csr_matrix, spec: RackSpec) -> None:
 def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matrix,
              r_y: FloatArray) -> tuple[sp.csr_matrix, float]:
     """K_E + K_G and the critical load factor; InputError if the gravity load buckles the rack.
+    A plane or a space rack (members in both bending planes, bracing bars included:
+    :mod:`seisrack.fe.geometric`).
 
     Gravity load F = -g·M·r_y: with the consistent member mass this is the consistent load
     vector of the members' self weight (a rigid vertical translation is exact in the element's
     shape functions), plus each pallet's weight on its support nodes' uy DOFs.
     """
     form = spec.second_order.form
-    N = geometric.gravity_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
-    K_G = geometric.geometric_stiffness(mesh, N, form)
+    N, N_bar = geometric.static_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
+    K_G = geometric.geometric_stiffness(mesh, N, form, N_bar)  # bars: their string stiffness
     lam = geometric.critical_load_factor(K_E, K_G)
     if lam <= 1.0:
         raise InputError(

@@ -16,11 +16,9 @@ from seisrack.errors import InputError
 #: feature -> the rack dimensions it is built for
 FEATURES: dict[str, tuple[int, ...]] = {
     "nonlinear connections ([hysteresis])": (2,),
-    "P-Δ ([second_order] p_delta)": (2,),
     "velocity-dependent friction (friction_rate)": (2,),
     "exact modal propagators (method exact)": (2,),
     "a cross-aisle ground motion component": (3,),
-    "the OpenSees export (seisrack export opensees)": (2,),
     "an incidence angle of the horizontal components": (3,),
 }
 
@@ -48,8 +46,6 @@ def check_features(spec: Any) -> None:
     if spec.hysteresis.nonlinear:
         require("nonlinear connections ([hysteresis])", ndm, "hysteresis", "nonlinear law",
                 source=src)
-    if spec.second_order.p_delta:
-        require("P-Δ ([second_order] p_delta)", ndm, "second_order.p_delta", True, source=src)
     rates = [i for i, p in enumerate(spec.pallets) if p.friction_rate]
     if rates:
         require("velocity-dependent friction (friction_rate)", ndm,

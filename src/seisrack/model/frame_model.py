@@ -60,9 +60,10 @@ class FrameModel:
             DOFs in each direction; pallet_vdof: (m, k) int their vertical DOFs.
         pallet_mass [kg], pallet_mu_static, pallet_mu_dynamic [-], pallet_friction_rate [s/m]
             (velocity dependence, 0: Coulomb): (m,).
-        pallet_level, pallet_bay, pallet_slot: (m,) int, 0-based (slot: position within its
-            bay and level, left to right); pallet_x: (m,) [m] position of its centre along
-            the rack; pallet_depth, pallet_overhang: (m,) [m] (nan when not given).
+        pallet_level, pallet_bay, pallet_slot, pallet_row: (m,) int, 0-based (slot: position
+            within its bay and level, left to right; row: 0, or 1 on the rear row of a
+            back-to-back rack); pallet_x: (m,) [m] position of its centre along the rack;
+            pallet_depth, pallet_overhang: (m,) [m] (nan when not given).
         layout: free distances down-aisle, fall distances cross-aisle and down-aisle contacts
             (:class:`~seisrack.model.pallet_layout.PalletLayout`).
 
@@ -80,6 +81,8 @@ class FrameModel:
             upright_base_elements: (n_col,); upright_below_elements, upright_above_elements:
             (n_col, n_level) (-1 above the top level).
         member_mass: [kg] all members and bars; g: [m/s²].
+        n_rows: rows of upright frames (1, or 2 back to back); frame_z: (n_side,) [m] z of
+            each upright side (column_side indexes it; (0.0,) in 2D).
 
     Hinges (every connection spring, connectors then base plates in mesh order; see
     :mod:`seisrack.dynamics.hinges`): hinge_dofs (n_h, 2) rotation DOFs (a, b), rotation
@@ -112,6 +115,7 @@ class FrameModel:
     pallet_level: IntArray
     pallet_bay: IntArray
     pallet_slot: IntArray
+    pallet_row: IntArray
     pallet_x: FloatArray
     pallet_depth: FloatArray
     pallet_overhang: FloatArray
@@ -145,6 +149,8 @@ class FrameModel:
     hinge_rotation_gravity: FloatArray
     title: str = ""
     critical_load_factor: float | None = None
+    n_rows: int = 1
+    frame_z: FloatArray | None = None
 
     # ------------------------------------------------------------------ dimension
     @property
@@ -205,10 +211,13 @@ class FrameModel:
         return self.mesh.node_dofs
 
     def pallet_labels(self) -> list[str]:
-        """``"L{level}-B{bay}-S{slot}"`` of each pallet (1-based), as every output names them."""
-        return [f"L{lv + 1}-B{b + 1}-S{s + 1}" for lv, b, s in
-                zip(self.pallet_level.tolist(), self.pallet_bay.tolist(),
-                    self.pallet_slot.tolist(), strict=True)]
+        """``"L{level}-B{bay}-S{slot}"`` of each pallet (1-based), as every output names them;
+        ``"R{row}-L…"`` on a back-to-back rack."""
+        rows = self.pallet_row.tolist() if self.n_rows > 1 else [None] * self.n_pallets
+        return [("" if r is None else f"R{r + 1}-") + f"L{lv + 1}-B{b + 1}-S{s + 1}"
+                for r, lv, b, s in zip(rows, self.pallet_level.tolist(),
+                                       self.pallet_bay.tolist(), self.pallet_slot.tolist(),
+                                       strict=True)]
 
     # ------------------------------------------------------------------ matrices
     @cached_property

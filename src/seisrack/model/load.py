@@ -34,6 +34,7 @@ from seisrack.model.spec import (
     Material,
     Pallet,
     RackSpec,
+    RowSpacer,
     SecondOrder,
     Section,
 )
@@ -179,15 +180,70 @@ def _lengths(t: Table, key: str) -> tuple[float, ...]:
 def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
     bays = _lengths(t, "bays")
     levels = _lengths(t, "levels")
+    depth = t.number("depth", positive=True, unit="m") if t.has("depth") else None
+    rows, spacer = _rows(t, sum(levels), depth, sections)
     geom = Geometry(
         bays=bays, levels=levels,
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
         upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
         subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
-        depth=t.number("depth", positive=True, unit="m") if t.has("depth") else None,
+        depth=depth, rows=rows, row_spacer=spacer,
     )
-    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth"))
+    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth",
+              "rows", "row_spacer"))
     return geom
+
+
+def _rows(t: Table, top: float, depth: float | None, sections: dict[str, Section]
+          ) -> tuple[int, RowSpacer | None]:
+    """``rows`` (1, or 2 back to back) and ``[geometry.row_spacer]``: 3D racks only."""
+    if depth is None:
+        for key in ("rows", "row_spacer"):
+            if t.has(key):
+                raise t.error(key, t.raw(key), "no rows or row spacers in a 2D rack (they "
+                              "are keys of a 3D rack)", hint="Give [geometry] depth (the "
+                              "upright-frame depth, m) for a 3D rack, then rows = 2 and "
+                              "[geometry.row_spacer] for a back-to-back (double-entry) rack")
+        return 1, None
+    rows = t.integer("rows", 1)
+    if rows not in (1, 2):
+        raise t.error("rows", rows, "1 (one row of upright frames) or 2 (two rows back to "
+                                    "back, joined by [geometry.row_spacer])")
+    if rows == 1:
+        if t.has("row_spacer"):
+            raise t.error("row_spacer", t.raw("row_spacer"), "no row spacer on a rack of one "
+                          "row", hint="Set [geometry] rows = 2 for a back-to-back rack")
+        return 1, None
+    if not t.has("row_spacer"):
+        raise t.error("row_spacer", None, "a [geometry.row_spacer] table (length, section, "
+                      "spacing or heights): two rows back to back are joined by row spacers")
+    st = t.table("row_spacer")
+    length = st.number("length", positive=True, unit="m")
+    section = st.string("section")
+    if section not in sections:
+        raise st.error("section", section, f"one of the [sections]: {', '.join(sorted(sections))}")
+    if st.has("spacing") == st.has("heights"):
+        raise st.error("spacing", st.raw("spacing", None), "either spacing (a vertical spacing, "
+                       "m) or heights (a list of heights, m), not both and not neither")
+    if st.has("spacing"):
+        h = st.number("spacing", positive=True, unit="m")
+        if h > top + _GEOM_TOL:
+            raise st.error("spacing", h, f"a spacing <= the upright height {top:g} m (a "
+                           "spacer must fit on the uprights)")
+        n = int(math.floor(top / h + 1e-9))
+        heights = [k * h for k in range(1, n + 1)]
+        if top - heights[-1] > 1e-6 * top:
+            heights.append(top)  # and one at the top of the uprights
+    else:
+        raw = st.array("heights", min_len=1)
+        heights = [check_number(v, f"{st.field('heights')}[{i}]", positive=True, unit="m",
+                                source=st.source) for i, v in enumerate(raw)]
+        if any(b <= a for a, b in zip(heights[:-1], heights[1:], strict=True)) \
+                or heights[-1] > top + _GEOM_TOL:
+            raise st.error("heights", raw, f"an increasing list of heights in (0, {top:g}] m "
+                           "(on the uprights, above the floor)")
+    st.finish(("length", "section", "spacing", "heights"))
+    return 2, RowSpacer(length=length, section=section, heights=tuple(heights))
 
 
 def _spring(t: Table, key: str) -> float:
@@ -330,6 +386,12 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
     if not 1 <= level <= geom.n_levels:
         raise t.error("level", level, f"an integer from 1 to {geom.n_levels} (the rack has "
                                       f"{geom.n_levels} beam level(s))")
+    row = t.integer("row", 1)
+    if not 1 <= row <= geom.rows:
+        raise t.error("row", row, f"an integer from 1 to {geom.rows} (the rack has "
+                                  f"{geom.rows} row(s) of upright frames)",
+                      hint=None if geom.rows > 1 else "A back-to-back rack has [geometry] "
+                      "rows = 2 (3D racks)")
     mu_s, mu_d = check_friction(t.field("mu_static"), t.raw("mu_static"),
                                 t.field("mu_dynamic"), t.raw("mu_dynamic"), source=t.source)
     width = t.number("width", DEFAULT_PALLET_WIDTH, positive=True, unit="m")
@@ -347,19 +409,20 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
         limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
     rate = friction_rate(t)
     fp = _footprint(t, geom)
-    t.finish(("mass", "bay", "level", "position", "mu_static", "mu_dynamic", "width",
+    t.finish(("mass", "bay", "level", "row", "position", "mu_static", "mu_dynamic", "width",
               "sliding_limit", "friction_rate") + _PALLET_3D_KEYS)
     return Pallet(mass=mass, bay=bay, level=level, position=position, mu_static=mu_s,
                   mu_dynamic=mu_d, width=width, sliding_limit=limit, friction_rate=rate,
-                  depth=fp.get("depth"), overhang=fp.get("overhang"))
+                  depth=fp.get("depth"), overhang=fp.get("overhang"), row=row)
 
 
 def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],
                     source: str | None) -> None:
-    """Pallets on the same bay and level must not overlap (``labels[i]`` names pallet i)."""
-    seen: dict[tuple[int, int], list[int]] = {}  # earlier pallets of each (bay, level)
+    """Pallets on the same bay, level and row must not overlap (``labels[i]`` names pallet
+    i)."""
+    seen: dict[tuple[int, int, int], list[int]] = {}  # earlier pallets of each cell
     for i, a in enumerate(pallets):
-        earlier = seen.setdefault((a.bay, a.level), [])
+        earlier = seen.setdefault((a.row, a.bay, a.level), [])
         for j in earlier:
             b = pallets[j]
             gap = abs(a.position - b.position) - (a.width + b.width) / 2
@@ -367,5 +430,6 @@ def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],
                 raise InputError(
                     f"{labels[i]}.position", a.position,
                     f"a position that does not overlap {labels[j]} (centre {b.position:g} m, "
-                    f"width {b.width:g} m) on bay {a.bay}, level {a.level}", source=source)
+                    f"width {b.width:g} m) on bay {a.bay}, level {a.level}"
+                    + (f", row {a.row}" if a.row > 1 else ""), source=source)
         earlier.append(i)

@@ -7,13 +7,21 @@ the pallets on one beam (pair) form a row between the uprights: each neighbourin
 end pallet with its upright, is a contact with a clear gap [m]. Contact ``c`` closes when
 ``u_x[left] − u_x[right] ≥ gap`` (the upright's sliding is 0).
 
-Cross-aisle (3D racks), a pallet rests on the front beam (z = 0) and the rear beam (z = depth) and
-overhangs them by ``o_front`` and ``o_rear``. Sliding towards the front aisle (−z) it loses the
-rear beam once its sliding exceeds ``o_rear``, and falls into the front aisle; sliding towards
-the rear it falls once the sliding exceeds ``o_front``. ``overhang`` is the front overhang; the
-rear one follows from the pallet depth (``depth − frame depth − overhang``, equal when the
-pallet is centred); with only a depth the pallet is centred; with neither, falls are not
-checked (nan). A 2D rack has no cross-aisle: its fall distances are nan.
+Cross-aisle (3D racks), a pallet rests on the front and the rear beam of its row and overhangs
+them by ``o_front`` and ``o_rear``. Sliding towards −z it loses the rear beam once its sliding
+exceeds ``o_rear``, and falls; sliding towards +z it falls once the sliding exceeds
+``o_front``. ``overhang`` is the front overhang; the rear one follows from the pallet depth
+(``depth − frame depth − overhang``, equal when the pallet is centred); with only a depth the
+pallet is centred; with neither, falls are not checked (nan). A 2D rack has no cross-aisle:
+its fall distances are nan.
+
+Where a pallet falls: a rack of one row has an aisle on either side, the *front aisle* (−z) and
+the *rear aisle* (+z). A back-to-back rack (two rows joined by row spacers) has the *flue*
+between its rows: row 1 falls into the front aisle or the flue, row 2 into the flue or the rear
+aisle (:data:`FRONT_AISLE`, :data:`FLUE`, :data:`REAR_AISLE`; :meth:`PalletLayout.fall_side`).
+The pallets of the two rows must leave the flue open: row 1's rear overhangs and row 2's front
+overhangs together shorter than the spacers. A pallet sliding into the flue is taken to fall
+there; that it may first meet a pallet of the other row is not modelled.
 """
 
 from __future__ import annotations
@@ -28,6 +36,8 @@ from seisrack.model.spec import Pallet, RackSpec
 
 #: index of "the upright" in a down-aisle contact pair
 UPRIGHT = -1
+#: where a pallet falls, cross-aisle
+FRONT_AISLE, FLUE, REAR_AISLE = "front aisle", "flue", "rear aisle"
 
 
 @dataclass(frozen=True)
@@ -36,7 +46,7 @@ class PalletLayout:
     fall_front, fall_rear: (m,) [m] sliding towards −z / +z at which pallet p falls (nan:
     not checked, and always on a 2D rack). contact_left, contact_right: (k,) pallet indices
     (UPRIGHT = −1) of each down-aisle contact, left at smaller x; contact_gap: (k,) [m] clear
-    gap."""
+    gap. row: (m,) 0-based row of each pallet; n_rows: rows of the rack (2: back to back)."""
 
     limit_neg: np.ndarray
     limit_pos: np.ndarray
@@ -45,27 +55,39 @@ class PalletLayout:
     contact_left: np.ndarray
     contact_right: np.ndarray
     contact_gap: np.ndarray
+    row: np.ndarray
+    n_rows: int = 1
+
+    def fall_side(self, pallet: int, sign: int) -> str:
+        """Where pallet ``pallet`` falls sliding towards −z (``sign`` < 0) or +z (> 0): the
+        front aisle, the flue or the rear aisle (module docstring)."""
+        r = int(self.row[pallet])
+        if sign < 0:
+            return FRONT_AISLE if r == 0 else FLUE
+        return REAR_AISLE if r == self.n_rows - 1 else FLUE
 
 
 def pallet_layout(spec: RackSpec) -> PalletLayout:
     """Free distances, fall distances and down-aisle contacts of the pallets of ``spec``."""
     neg, pos = sliding_limits(spec)
     front, rear = _fall_distances(spec)
+    _check_flue(spec, front, rear)
     left, right, gap = _contacts(spec)
-    return PalletLayout(neg, pos, front, rear, left, right, gap)
+    row = np.array([p.row - 1 for p in spec.pallets], dtype=np.int64)
+    return PalletLayout(neg, pos, front, rear, left, right, gap, row, spec.geometry.rows)
 
 
 def sliding_limits(spec: RackSpec) -> tuple[np.ndarray, np.ndarray]:
     """Allowed sliding of each pallet towards -x and +x [m], both >= 0 (module docstring)."""
     n = len(spec.pallets)
     neg, pos = np.zeros(n), np.zeros(n)
-    shelves: dict[tuple[int, int], list[Pallet]] = {}  # pallets sharing a bay and level
+    shelves: dict[tuple[int, int, int], list[Pallet]] = {}  # sharing a bay, level and row
     for p in spec.pallets:
-        shelves.setdefault((p.bay, p.level), []).append(p)
+        shelves.setdefault((p.row, p.bay, p.level), []).append(p)
     for i, p in enumerate(spec.pallets):
         left, right = p.position - p.width / 2, p.position + p.width / 2
         wall_l, wall_r = 0.0, spec.geometry.bays[p.bay - 1]
-        for q in shelves[(p.bay, p.level)]:
+        for q in shelves[(p.row, p.bay, p.level)]:
             if q is p:
                 continue
             if q.position < p.position:
@@ -104,14 +126,33 @@ def _fall_distances(spec: RackSpec) -> tuple[np.ndarray, np.ndarray]:
     return front, rear
 
 
+def _check_flue(spec: RackSpec, front: np.ndarray, rear: np.ndarray) -> None:
+    """The two rows' overhangs into the flue must leave it open (module docstring)."""
+    sp = spec.geometry.row_spacer
+    if spec.geometry.rows < 2 or sp is None:
+        return
+    row = np.array([p.row for p in spec.pallets], dtype=np.int64)
+    # into the flue: row 1's rear overhang (its fall distance to the front) and row 2's front
+    # overhang (its fall distance to the rear)
+    o1, o2 = front[row == 1], rear[row == 2]
+    o1, o2 = o1[np.isfinite(o1)], o2[np.isfinite(o2)]
+    into = (o1.max() if o1.size else 0.0) + (o2.max() if o2.size else 0.0)
+    if into >= sp.length:
+        raise InputError("geometry.row_spacer.length", sp.length,
+                         f"a flue longer than the pallets' overhangs into it ({into:g} m: row "
+                         "1's rear and row 2's front overhangs)", source=spec.source,
+                         hint="The pallets of the two rows would overlap in the flue: "
+                              "lengthen the row spacers or reduce the overhangs")
+
+
 def _contacts(spec: RackSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     left: list[int] = []
     right: list[int] = []
     gap: list[float] = []
-    rows: dict[tuple[int, int], list[int]] = {}
+    rows: dict[tuple[int, int, int], list[int]] = {}
     for i, p in enumerate(spec.pallets):
-        rows.setdefault((p.level, p.bay), []).append(i)
-    for (_lev, bay), idx in sorted(rows.items()):
+        rows.setdefault((p.row, p.level, p.bay), []).append(i)
+    for (_row, _lev, bay), idx in sorted(rows.items()):
         idx.sort(key=lambda i: spec.pallets[i].position)
         span = spec.geometry.bays[bay - 1]
         prev, edge = UPRIGHT, 0.0

@@ -24,7 +24,7 @@ from seisrack.model.spec import RackSpec
 _MERGE_TOL = 1e-6  # relative to the span: pallet centres this close to a station reuse it
 
 #: element_kind of a beam-column, truss_kind of a bar
-UPRIGHT, BEAM, BRACING, SPINE = 0, 1, 2, 3
+UPRIGHT, BEAM, BRACING, SPINE, SPACER = 0, 1, 2, 3, 4
 
 
 @dataclass(frozen=True)
@@ -32,13 +32,14 @@ class RackMesh:
     """The mesh plus the rack bookkeeping needed by compile_rack, for a 2D or a 3D rack.
 
     An upright *column* is one upright of one upright line: a plane rack has one per line, a
-    space rack two (front, side 0, at z = 0 and rear, side 1, at z = depth), column
-    ``c = n_side·line + side``.
+    space rack two per row (front, side 0, at z = 0 and rear, side 1, at z = depth; a
+    back-to-back rack's row 2 has sides 2 and 3), column ``c = n_side·line + side``; side ``s``
+    belongs to row ``s // 2`` of a space rack.
 
     element_kind (UPRIGHT, BEAM), element_storey (storey of an upright, level of a beam),
     element_line (upright line of an upright, bay of a beam), element_side: (n_el,) int.
-    truss_kind (BRACING, SPINE), truss_line (upright line of a bracing bar, bay of a spine
-    bar): (n_tr,) int.
+    truss_kind (BRACING, SPINE, SPACER), truss_line (upright line of a bracing bar or a row
+    spacer, bay of a spine bar): (n_tr,) int.
     column_line, column_side: (n_col,) int. base_nodes: (n_col,) int; level_nodes:
     (n_col, n_level) int, the upright node at each beam level.
     upright_base_elements: (n_col,) lowest element of each column; upright_below_elements,

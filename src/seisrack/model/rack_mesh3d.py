@@ -1,23 +1,31 @@
 """Geometry → mesh of a space (3D) rack, a :class:`~seisrack.model.rack_mesh.RackMesh`:
-uprights, front and rear beams, bracing, DOF map and springs.
+uprights, front and rear beams, bracing, row spacers, DOF map and springs.
 
-Global axes: x down-aisle (along the beams), y up, z cross-aisle; the front frame is the plane
-z = 0, the rear frame z = ``depth``. Six DOFs per node ``(ux, uy, uz, rx, ry, rz)``.
+Global axes: x down-aisle (along the beams), y up, z cross-aisle. A rack of one row has its
+front frame in the plane z = 0 and its rear frame at z = ``depth``; a back-to-back rack
+(``[geometry] rows = 2``) has row 2's frames at z = depth + length and 2·depth + length (length:
+the row spacers'), so four upright *sides* (0, 1: row 1 front and rear; 2, 3: row 2), given by
+:attr:`~seisrack.model.spec.Geometry.frame_z`. Six DOFs per node ``(ux, uy, uz, rx, ry, rz)``.
 
 - Uprights (beam-columns, ``vecxz`` = +z): local z = global z, so ``Iz`` (the 2D ``I``) is
   bending in the down-aisle plane and ``Iy`` cross-aisle bending. Nodes at the ``subdivisions``
-  divisions of every storey, at every panel point and at every bracing end (merged when within
-  1e-6 m).
-- Beams (``vecxz`` = +z): a front and a rear beam in every bay and level, stations as in 2D
-  (:func:`seisrack.model.rack_mesh.beam_stations`). A beam end is its own node sharing the
-  upright node's translations and its rotations rx, ry (rigid in those directions) and, for a
-  semi-rigid or pinned connector, owning its rotation rz about the cross-aisle axis, tied to
-  the upright's by a spring (none for pinned); a rigid connector shares rz too.
+  divisions of every storey, at every panel point, every bracing end and every row spacer
+  (merged when within 1e-6 m).
+- Beams (``vecxz`` = +z): one per side in every bay and level (a front and a rear beam per
+  row), stations as in 2D (:func:`seisrack.model.rack_mesh.beam_stations`; every beam of a bay
+  and level has the same stations, from the pallets of both rows). A beam end is its own node
+  sharing the upright node's translations and its rotations rx, ry (rigid in those directions)
+  and, for a semi-rigid or pinned connector, owning its rotation rz about the cross-aisle axis,
+  tied to the upright's by a spring (none for pinned); a rigid connector shares rz too.
 - Bases: translations and the twist ry fixed; rz (down-aisle bending) and rx (cross-aisle
   bending) each fixed (rigid), free with a spring to the ground (semi-rigid: ``base`` and
   ``base_cross``) or free (pinned).
-- Bracing: pin-ended bars (3D trusses) between upright nodes of each upright frame, and the
-  spine diagonals in the rear plane; eccentricities ignored.
+- Bracing: pin-ended bars (3D trusses) between upright nodes of each upright frame, the same in
+  each row (F its front, R its rear upright), and the spine diagonals in each row's back plane
+  (the rear frame of row 1, the front frame of row 2: the faces on the flue, the aisle faces
+  being the loading faces); eccentricities ignored.
+- Row spacers (back-to-back racks): pin-ended bars joining the inner uprights of the two rows
+  (sides 1 and 2) on every upright line at the spacer heights; eccentricities ignored.
 """
 
 from __future__ import annotations
@@ -28,7 +36,15 @@ import numpy as np
 
 from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.model.bracing import FRONT
-from seisrack.model.rack_mesh import BEAM, BRACING, SPINE, UPRIGHT, RackMesh, beam_stations
+from seisrack.model.rack_mesh import (
+    BEAM,
+    BRACING,
+    SPACER,
+    SPINE,
+    UPRIGHT,
+    RackMesh,
+    beam_stations,
+)
 from seisrack.model.spec import RackSpec
 
 _Z_AXIS = (0.0, 0.0, 1.0)
@@ -36,13 +52,16 @@ _MERGE = 1e-6  # m
 
 
 def _upright_heights(spec: RackSpec) -> FloatArray:
-    """Heights of the upright nodes: storey divisions, panel points and bracing ends."""
+    """Heights of the upright nodes: storey divisions, panel points, bracing ends and row
+    spacers."""
     geo = spec.geometry
     ys = (0.0, *geo.level_y)
     pts = [float(y) for s in range(geo.n_levels)
            for y in np.linspace(ys[s], ys[s + 1], geo.subdivisions + 1)]
     assert spec.bracing is not None
     pts += list(spec.bracing.heights)
+    if geo.row_spacer is not None:
+        pts += list(geo.row_spacer.heights)
     out: list[float] = []
     for y in sorted(pts):
         if not out or y - out[-1] > _MERGE:
@@ -54,7 +73,8 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
     geo, br = spec.geometry, spec.bracing
     assert geo.depth is not None and br is not None
     n_lev, n_line = geo.n_levels, geo.n_bays + 1
-    xs, zs = geo.upright_x, (0.0, geo.depth)
+    xs, zs = geo.upright_x, geo.frame_z
+    n_side = len(zs)  # 2 per row
     k_joint = spec.connections.beam_to_upright
     k_base, k_cross = spec.connections.base, spec.connections.base_cross_k
     heights = _upright_heights(spec)
@@ -73,7 +93,7 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
     el: list[tuple[int, int]] = []
     props: list[tuple[str, int, int, int, int]] = []  # section, kind, storey, line, side
     springs: list[tuple[int, int, float]] = []
-    n_col = 2 * n_line  # column 2 line + side
+    n_col = n_side * n_line  # column n_side·line + side
     base_nodes = np.zeros(n_col, dtype=np.int64)
     level_nodes = np.zeros((n_col, n_lev), dtype=np.int64)
     base_el = np.zeros(n_col, dtype=np.int64)
@@ -91,7 +111,7 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
 
     for c, x in enumerate(xs):
         for side, z in enumerate(zs):
-            col = 2 * c + side
+            col = n_side * c + side
             ids = [len(nodes)]
             base_nodes[col] = ids[0]
             nodes.append((x, 0.0, z))
@@ -128,7 +148,7 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
                     node = len(nodes)
                     nodes.append((xs[bay] + float(sx), float(level_y[lev]), z))
                     if i in (0, len(st) - 1):
-                        up = dofs[level_nodes[2 * (bay + (i > 0)) + side, lev]]
+                        up = dofs[level_nodes[n_side * (bay + (i > 0)) + side, lev]]
                         if math.isinf(k_joint):
                             dofs.append(list(up))
                         else:
@@ -150,17 +170,24 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
     def node_at(c: int, side: int, y: float) -> int:
         return int(at_height[(c, side)][int(np.argmin(np.abs(heights - y)))])
 
-    for c in range(n_line):
-        for (sa, ya, sb, yb), sec in zip(br.members, br.sections, strict=True):
-            tr.append((node_at(c, sa, ya), node_at(c, sb, yb)))
-            tr_props.append((sec, BRACING, c))
-    rear = 1 - FRONT
+    rows = n_side // 2
+    for r in range(rows):  # each row's upright frames braced alike (F: side 2r, R: 2r + 1)
+        for c in range(n_line):
+            for (sa, ya, sb, yb), sec in zip(br.members, br.sections, strict=True):
+                tr.append((node_at(c, 2 * r + sa, ya), node_at(c, 2 * r + sb, yb)))
+                tr_props.append((sec, BRACING, c))
     ys = np.concatenate([[0.0], level_y])
-    for bay in br.spine_bays:
-        for s in br.spine_levels:
-            lo, hi = (bay, bay + 1) if s % 2 == 0 else (bay + 1, bay)
-            tr.append((node_at(lo, rear, ys[s]), node_at(hi, rear, ys[s + 1])))
-            tr_props.append((br.spine_section or "", SPINE, bay))
+    for back in (1 - FRONT, 2)[:rows]:  # each row's back plane: the faces on the flue
+        for bay in br.spine_bays:
+            for s in br.spine_levels:
+                lo, hi = (bay, bay + 1) if s % 2 == 0 else (bay + 1, bay)
+                tr.append((node_at(lo, back, ys[s]), node_at(hi, back, ys[s + 1])))
+                tr_props.append((br.spine_section or "", SPINE, bay))
+    if geo.row_spacer is not None:  # row 1's rear uprights to row 2's front uprights
+        for c in range(n_line):
+            for y in geo.row_spacer.heights:
+                tr.append((node_at(c, 1, y), node_at(c, 2, y)))
+                tr_props.append((geo.row_spacer.section, SPACER, c))
 
     secs = spec.sections
     n_el = len(el)
@@ -185,8 +212,8 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
     return RackMesh(mesh=mesh, element_kind=arr[:, 0].copy(), element_storey=arr[:, 1].copy(),
                     element_line=arr[:, 2].copy(), element_side=arr[:, 3].copy(),
                     truss_kind=tarr[:, 0].copy(), truss_line=tarr[:, 1].copy(),
-                    column_line=np.repeat(np.arange(n_line, dtype=np.int64), 2),
-                    column_side=np.tile(np.arange(2, dtype=np.int64), n_line),
+                    column_line=np.repeat(np.arange(n_line, dtype=np.int64), n_side),
+                    column_side=np.tile(np.arange(n_side, dtype=np.int64), n_line),
                     base_nodes=base_nodes, level_nodes=level_nodes, upright_base_elements=base_el,
                     upright_below_elements=below, upright_above_elements=above,
                     beam_nodes=b_nodes, beam_stations=b_st)

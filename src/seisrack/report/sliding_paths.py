@@ -1,6 +1,7 @@
 """Where the pallets of a rack with two horizontal directions (a 3D rack) slide, in plan:
 :func:`plot_sliding_paths`, a plan view of each loaded beam level (x down-aisle along the rack,
-z cross-aisle: front beam at z = 0, rear beam at z = depth) with every pallet's footprint and
+z cross-aisle: front beam at z = 0, rear beam at z = depth, and the second row's frames of a
+back-to-back rack beyond the flue) with every pallet's footprint and
 the path of its centre, magnified so that small sliding is visible; the fall limits are dashed
 on each footprint and fallen pallets are red. Written as ``sliding_paths.png`` by
 :func:`seisrack.report.rack_plot.save_rack_figures`.
@@ -69,7 +70,12 @@ def plot_sliding_paths(
     mag = default_magnify(peak) if magnify is None else float(magnify)
     w = np.full(m, DEFAULT_WIDTH) if widths is None else np.asarray(widths, dtype=float)
     depth = float(model.depth)
-    zc = depth / 2
+    # each pallet centred between the two beams it rests on (its row's, on a back-to-back
+    # rack); a frame line at each upright side
+    support_z = np.asarray(model.nodes)[np.asarray(model.pallet_node), 2]
+    zc_all = support_z.mean(axis=1) if support_z.size else np.zeros(0)
+    frames = (np.asarray(model.frame_z) if getattr(model, "frame_z", None) is not None
+              else np.array([0.0, depth]))
     px = np.asarray(model.nodes)[np.asarray(model.pallet_node)[:, 0], 0]
     pdep = np.where(np.isfinite(model.pallet_depth), model.pallet_depth, depth)
     up_x = np.asarray(model.upright_x)
@@ -79,11 +85,12 @@ def plot_sliding_paths(
                              figsize=(max(6.0, 1.6 * (up_x[-1] - up_x[0]) + 2.0),
                                       1.0 + 2.6 * len(levels)))
     for ax, lv in zip(axes[:, 0], levels, strict=True):
-        for z in (0.0, depth):
+        for z in frames:
             ax.plot([up_x[0], up_x[-1]], [z, z], color="0.3", lw=2.0, zorder=1)
-        ax.plot(np.repeat(up_x, 2), np.tile([0.0, depth], up_x.size), "s", color="0.2",
+        ax.plot(np.repeat(up_x, frames.size), np.tile(frames, up_x.size), "s", color="0.2",
                 ms=5, zorder=2, label="uprights")
         for p in np.flatnonzero(resp.pallet_level == lv - 1):
+            zc = zc_all[p]
             fall = falls.get(int(p))
             colour = "red" if fall is not None else "C0"
             x0, hw, hd = px[p], w[p] / 2, pdep[p] / 2
