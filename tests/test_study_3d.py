@@ -208,3 +208,19 @@ def test_summary_fits_the_aisle_falls_and_the_directions(stored) -> None:
     names = set(g["stripes"]["fragility"])
     assert {"aisle_fall", "sliding_down_aisle>0.05m", "sliding_cross_aisle>0.05m"} <= names
     assert "aisle_fall" in s["damage_states"]
+
+
+def test_falls_into_the_flue_are_not_aisle_falls() -> None:
+    """A back-to-back rack's pallet that falls into the flue counts among the falls, not among
+    the falls into an aisle (the study's fragility state)."""
+    from types import SimpleNamespace
+
+    from seisrack.analysis.pallet_contacts import Fall
+    from seisrack.studies.executors import _direction_columns
+
+    res = SimpleNamespace(falls=[Fall(0, 1.0, "flue"), Fall(3, 2.0, "rear aisle")],
+                          pallet_peak_sliding_by_direction=lambda: np.ones((4, 2)))
+    cols = _direction_columns(res)
+    assert (cols["n_aisle_fall"], cols["any_aisle_fall"]) == (1, True)
+    res.falls = [Fall(0, 1.0, "flue")]
+    assert _direction_columns(res)["any_aisle_fall"] is False

@@ -113,3 +113,14 @@ def test_plan_figure(tmp_path: Path) -> None:
     assert len(ax.patches) == w.n_rows
     ax.figure.savefig(tmp_path / "plan.png")
     assert (tmp_path / "plan.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_back_to_back_rack_is_as_deep_as_its_two_rows_and_flue() -> None:
+    from seisrack.model import load_rack
+    from seisrack.studies.warehouse import warehouse_from_dict
+
+    ex = Path(__file__).resolve().parents[1] / "examples"
+    geo = load_rack(ex / "warehouse_rack_3d_b2b.toml").geometry
+    w = warehouse_from_dict({"rows": [{"rack": "warehouse_rack_3d_b2b.toml"}]}, base=ex)
+    assert geo.rows == 2
+    assert w.rows[0].depth == pytest.approx(2 * geo.depth + geo.row_spacer.length)

@@ -165,7 +165,10 @@ def _fall_lines(summary: dict[str, Any]) -> list[str]:
     if summary["dimension"] != "3D":
         return []
     out = [f"Pallets checked for falls into the aisles: {summary['pallets_checked_for_falls']} "
-           f"of {len(summary['pallets'])}; falling: {summary['pallets_falling']}"]
+           f"of {len(summary['pallets'])}; falling: {summary['pallets_falling']}"
+           + ("" if summary["pallets_falling_into_aisle"] == summary["pallets_falling"] else
+              f" ({summary['pallets_falling_into_aisle']} into an aisle, the others into the "
+              "flue)")]
     by = ", ".join(f"level {k}: {v}" for k, v in summary["falls_by_level"].items() if v)
     if by:
         out.append(f"  falls by level: {by}")

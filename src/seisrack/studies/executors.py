@@ -251,7 +251,8 @@ def _direction_columns(res) -> dict[str, Any]:  # noqa: ANN001
     direction."""
     by_dir = res.pallet_peak_sliding_by_direction()
     peak = by_dir.max(axis=0) if by_dir.size else np.zeros(by_dir.shape[1])
-    return {"any_aisle_fall": bool(res.falls), "n_aisle_fall": len(res.falls),
+    aisle = sum(1 for f in res.falls if f.into_aisle)  # a back-to-back rack's flue excluded
+    return {"any_aisle_fall": aisle > 0, "n_aisle_fall": aisle,
             "peak_sliding_down_aisle_max_m": float(peak[0]),
             "peak_sliding_cross_aisle_max_m": float(peak[1]) if peak.size > 1 else None}
 

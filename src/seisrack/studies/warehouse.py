@@ -140,6 +140,15 @@ def _pair(t: Table, key: str, default: Any) -> tuple[float, float]:
             check_number(val[1], f"{t.field(key)}[1]", unit="m", source=t.source))
 
 
+def _plan_depth(geometry: Any) -> float:
+    """A rack's plan depth: a 2D rack's default, a 3D rack's front frame to rear frame (both
+    rows and the flue of a back-to-back rack)."""
+    z = getattr(geometry, "frame_z", (0.0,))
+    if getattr(geometry, "depth", None) is None:
+        return DEFAULT_DEPTH_2D
+    return float(z[-1] - z[0]) if len(z) > 1 else float(geometry.depth)
+
+
 def _row(t: Table, i: int, base: Path) -> WarehouseRow:
     from seisrack.model import load_rack
 
@@ -168,7 +177,7 @@ def _row(t: Table, i: int, base: Path) -> WarehouseRow:
                           f"depth = {depth_3d:g} m)")
         depth = t.number("depth", positive=True, unit="m")
     else:
-        depth = float(depth_3d) if depth_3d is not None else DEFAULT_DEPTH_2D
+        depth = _plan_depth(spec.geometry)
     t.finish(_ROW_KEYS)
     if count > 1 and math.hypot(*spacing) == 0.0:
         raise t.error("spacing", list(spacing), "a non-zero offset between the rows of a group")

@@ -220,9 +220,13 @@ def _falls_html(summary: dict[str, Any]) -> str:
                 f"<td>{f['level']}</td><td>{f['bay']}</td>" + num_cell(f["time_s"], 1, "{:.3f}",
                                                                        "time_s")
                 + f"<td>{esc(f['side'])}</td></tr>" for f in falls]
-        out.append('<table id="table-falls"><caption>Pallets falling into an aisle (first '
+        flue = sum(1 for f in falls if f["side"] == "flue")
+        out.append('<table id="table-falls"><caption>Pallets falling off the beams (first '
                    f"crossing of the overhang), {len(falls)} of "
-                   f"{summary.get('pallets_checked_for_falls', 0)} checked. The model keeps a "
+                   f"{summary.get('pallets_checked_for_falls', 0)} checked"
+                   + (f", {flue} of them into the flue between the rows" if flue else
+                      ", each into an aisle")
+                   + ". The model keeps a "
                    "fallen pallet on its beams: its sliding after the fall is not physical."
                    "</caption><thead><tr><th>pallet</th><th>label</th><th>level</th><th>bay</th>"
                    "<th>time [s]</th><th>side</th></tr></thead><tbody>"
