@@ -103,7 +103,9 @@ class ContactTracker:
                         self.fall_time[p] = tr
                         self.fall_side[p] = sign
         todo = np.flatnonzero(np.isnan(self.impact_time))
-        if todo.size:
+        # a closure u_left - u_right - gap is at most 2 max|u| - gap: most chunks stop here
+        if todo.size and 2.0 * float(np.abs(u[:, :, 0]).max(initial=0.0)) >= float(
+                lay.contact_gap[todo].min()):
             ux = np.zeros((t.size, u.shape[1] + 1))
             ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
             left, right = lay.contact_left[todo], lay.contact_right[todo]
