@@ -195,7 +195,7 @@ def test_refuses_to_overwrite_without_force(study, capsys):
     capsys.readouterr()
     assert summary_main([str(root), *ARGS, "--report", str(report)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error:") and "--force" in err and "Traceback" not in err
+    assert err.startswith("seisrack: error:") and "--force" in err and "Traceback" not in err
     assert err.strip().count("\n") == 0  # one paragraph
     assert report.read_bytes() == before
     # --force rewrites it: mark the old file so the check does not hang on the clock (the

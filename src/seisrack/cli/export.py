@@ -64,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
     if out is None:
         sys.stdout.write(text)
         return 0
-    out.write_text(text, encoding="utf-8")
+    from seisrack.atomic import write_text
+
+    write_text(out, text)
     print(f"OpenSeesPy script written to {out} (run: python {out})", file=sys.stderr)
     return 0

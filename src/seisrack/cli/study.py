@@ -3,7 +3,7 @@
 
 The first form expands the study (every input error is reported before any run starts), then
 runs what ``DIR`` does not hold yet: running the same command again resumes. ``summary`` is
-delegated to :func:`seisrack.studies.summary.summary_main` with the remaining arguments.
+delegated to :mod:`seisrack.cli.study_summary` with the remaining arguments.
 """
 
 from __future__ import annotations
@@ -48,22 +48,15 @@ def _add_options(p: argparse.ArgumentParser, defaults: bool = True) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.study == "summary":
-        from seisrack.errors import InputError
+        from seisrack.cli.study_summary import run as summary
 
-        try:
-            from seisrack.studies.summary import summary_main
-        except ModuleNotFoundError as exc:
-            if exc.name != "seisrack.studies.summary":
-                raise
-            raise InputError("study summary", None, "a seisrack with seisrack.studies.summary",
-                             hint="This build has no study summary yet") from None
         argv = list(args.rest)
         for flag in ("json",):  # options argparse took for itself belong to the summary
             if getattr(args, flag):
                 argv.append(f"--{flag}")
         if args.out:
             argv += ["--out", args.out]
-        return int(summary_main(argv) or 0)
+        return summary(argv)
     return _run_study(args)
 
 

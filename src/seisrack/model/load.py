@@ -51,7 +51,7 @@ def load_rack(path: str | Path) -> RackSpec:
     with p.open("rb") as fh:
         raw = fh.read()
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        data = tomllib.loads(raw.decode("utf-8-sig"))  # a BOM (Windows Notepad) is fine
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
     except tomllib.TOMLDecodeError as exc:

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.fe.elements import rotation
 from seisrack.fe.mesh import FloatArray
 
@@ -101,6 +102,6 @@ def save_modes_figure(model: Any, modal: Any, path: str | Path, n_shapes: int = 
         plot_mode_shape(model, modal, k + 1, axes[0, k + 1])
     fig.tight_layout()
     out = Path(path)
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     plt.close(fig)
     return out

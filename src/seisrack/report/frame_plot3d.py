@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.fe.mesh import FloatArray
 
 
@@ -88,6 +89,6 @@ def save_modes_figure_3d(model: Any, modal: Any, path: str | Path, n_shapes: int
         plot_mode_shape_3d(model, modal, k + 1, fig.add_subplot(1, n, k + 1, projection="3d"))
     fig.tight_layout()
     out = Path(path)
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     plt.close(fig)
     return out

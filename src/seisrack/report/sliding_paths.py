@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from seisrack.analysis.rack3d import RackResponse3D
+from seisrack.atomic import save_figure
 
 #: file names written by :func:`save_rack3d_figures`
 RACK3D_FIGURES = ("sliding_paths.png", "pallet_sliding.png")
@@ -194,7 +195,7 @@ def save_rack3d_figures(resp: RackResponse3D, model: Any, out: str | Path, *,
             title = fig.get_suptitle()
             fig.suptitle(f"{suptitle}\n{title}" if title else suptitle, fontsize=9)
         fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
+        save_figure(fig, out / name, dpi=120)
         plt.close(fig)
         paths.append(out / name)
     return paths

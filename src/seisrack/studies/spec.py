@@ -152,7 +152,7 @@ def load_study(path: str | Path) -> StudySpec:
         raise InputError("study", str(p), "an existing study TOML file")
     raw = p.read_bytes()
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a BOM (Windows Notepad) is fine
         data = tomllib.loads(text)
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None

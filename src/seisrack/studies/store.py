@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
+
+from seisrack.atomic import atomic_write, write_text
 
 #: row columns in order: (name, pyarrow type name)
 COLUMNS = (
@@ -71,10 +72,8 @@ def write_part(out_dir: str | Path, rows: list[dict[str, Any]]) -> Path | None:
     runs.mkdir(parents=True, exist_ok=True)
     digest = hashlib.sha256("\n".join(sorted(r["run_id"] for r in rows)).encode()).hexdigest()
     path = runs / f"part-{digest[:20]}.parquet"
-    tmp = runs / f".{path.name}.{os.getpid()}.tmp"
-    pq.write_table(rows_to_table(rows), tmp)
-    os.replace(tmp, path)
-    return path
+    table = rows_to_table(rows)
+    return atomic_write(path, lambda tmp: pq.write_table(table, tmp))
 
 
 def part_files(out_dir: str | Path) -> list[Path]:
@@ -153,8 +152,4 @@ def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa
                                         if spec.intensity.ida_stop else None)},
         "runs": [asdict(r) for r in runs],
     }
-    path = out / STUDY_JSON
-    tmp = out / f".{STUDY_JSON}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps(doc, indent=1, allow_nan=True))
-    os.replace(tmp, path)
-    return path
+    return write_text(out / STUDY_JSON, json.dumps(doc, indent=1, allow_nan=True))

@@ -25,19 +25,18 @@ Theta is in the units of the intensity measure as stored: m/s² for both PGA and
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import logging
 import math
-import sys
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from seisrack.errors import InputError, SeisrackError
+from seisrack.atomic import atomic_write, save_figure, write_text
+from seisrack.errors import InputError
 from seisrack.studies import fragility as fr
 
 __all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
@@ -281,16 +280,20 @@ def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None
     folder.mkdir(parents=True, exist_ok=True)
     files = {"summary_json": str(folder / "summary.json"),
              "fragility_csv": str(folder / "fragility.csv")}
-    with open(folder / "fragility.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
-        w.writeheader()
-        for row in summary["fragility"]:
-            w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in w.fieldnames})
+    def write_csv(path: Path) -> None:
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
+            w.writeheader()
+            for row in summary["fragility"]:
+                w.writerow({k: ("" if row.get(k) is None else row.get(k))
+                            for k in w.fieldnames})
+
+    atomic_write(folder / "fragility.csv", write_csv)
     if plots:
         files.update(_figures(folder, summary, boots))
     summary["files"] = files
-    (folder / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1,
-                                                    allow_nan=False))
+    write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=1,
+                                                   allow_nan=False))
 
 
 def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
@@ -320,7 +323,7 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                                im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "fragility.png", dpi=120)
+        save_figure(fig, folder / "fragility.png", dpi=120)
         plt.close(fig)
         files["fragility_png"] = str(folder / "fragility.png")
     ida = [g for g in summary["groups"] if "ida" in g]
@@ -331,7 +334,7 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                      threshold=summary["d_slide_m"][0], ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "ida.png", dpi=120)
+        save_figure(fig, folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
     return files
@@ -400,51 +403,8 @@ def format_summary(s: dict[str, Any]) -> str:
 
 
 def summary_main(argv: list[str]) -> int:
-    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]
-    [--report FILE.html [--force]]``."""
-    p = argparse.ArgumentParser(prog="seisrack study summary",
-                                description="Summarise a study: counts, EC8 means, fragility.")
-    p.add_argument("dir", help="the study output folder (--out of `seisrack study`)")
-    p.add_argument("--d-slide", type=float, nargs="+", default=list(DEFAULT_D_SLIDE),
-                   metavar="D", help="sliding thresholds [m] (default 0.05)")
-    p.add_argument("--shear-capacity", type=float, default=None, metavar="N",
-                   help="base shear capacity [N] for the 'base shear > capacity' state")
-    p.add_argument("--boot", type=int, default=200, metavar="N", help="bootstrap resamples")
-    p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
-    p.add_argument("--no-plots", action="store_true", help="skip the figures")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--report", metavar="FILE.html", default=None,
-                   help="also write the study's self-contained HTML report")
-    p.add_argument("--force", action="store_true", help="overwrite an existing --report")
-    try:
-        a = p.parse_args(argv)
-    except SystemExit as exc:  # argparse already printed its usage message
-        return int(exc.code or 0)
-    if a.boot < 0:
-        print("error: --boot must be >= 0", file=sys.stderr)
-        return 2
-    boots: list = []
-    try:
-        if a.report:  # refuse an existing report before any work
-            from seisrack.report.html import check_report_path
+    """``seisrack study summary DIR ...`` (see :mod:`seisrack.cli.study_summary`), with the
+    command line's error contract: exit 2 and one paragraph (a JSON object under ``--json``)."""
+    from seisrack.cli import main
 
-            check_report_path(a.report, a.force, field="--report")
-        s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
-                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots)
-        if a.report:
-            from seisrack.report.html import write_study_report
-
-            html = write_study_report(a.report, _jsonable(s), out_dir=a.dir, boots=boots,
-                                      seed=a.seed, force=a.force)
-            s.setdefault("files", {})["report_html"] = str(html)
-    except SeisrackError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (OSError, ImportError, ValueError) as exc:  # unreadable part files
-        print(f"error: could not read the study in {a.dir}: {exc}", file=sys.stderr)
-        return 2
-    if a.json:
-        print(json.dumps(_jsonable(s), allow_nan=False))
-    else:
-        print(format_summary(s))
-    return 0
+    return main(["study", "summary", *argv])

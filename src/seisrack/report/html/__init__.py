@@ -42,12 +42,11 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
 def write_atomically(p: Path, text: str) -> Path:
     """Write ``text`` to a temporary file beside ``p``, then rename it: a reader never sees a
     half-written report, and a failed write leaves what was there."""
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    from seisrack.atomic import write_text
+
     try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, p)
+        write_text(p, text)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         raise InputError("path", str(p), "a writable path",
                          hint=str(exc.strerror or exc)) from None
     return p
