@@ -1,4 +1,5 @@
-"""``seisrack export opensees RACK.toml [--pallets friction|rigid] [--mu MU] [--out FILE]``.
+"""``seisrack export opensees RACK.toml [--pallets friction|rigid] [--mu MU] [--out FILE]
+[--json]``.
 
 Thin: load and compile the rack, call :func:`seisrack.export.opensees_script`, write the text
 to stdout or to ``--out`` (never over an existing file without ``--force``).
@@ -37,6 +38,9 @@ def register(subparsers: Any) -> None:
                    help="[N/m] initial stiffness of the friction springs (default 1e8)")
     o.add_argument("--out", metavar="FILE", help="write the script here instead of stdout")
     o.add_argument("--force", action="store_true", help="overwrite an existing --out file")
+    o.add_argument("--json", action="store_true",
+                   help="print one JSON object: what was exported and, without --out, the "
+                        "script itself (key 'script')")
     o.set_defaults(func=run)
 
 
@@ -61,11 +65,20 @@ def run(args: argparse.Namespace) -> int:
     # [hysteresis] laws: each connection spring gets the law's OpenSees material
     text = opensees_script(model, pallets=args.pallets, mu=args.mu, k_init=args.k_init,
                            source=Path(args.rack).name, hysteresis=spec.hysteresis)
-    if out is None:
-        sys.stdout.write(text)
-        return 0
-    from seisrack.atomic import write_text
+    if out is not None:
+        from seisrack.atomic import write_text
 
-    write_text(out, text)
-    print(f"OpenSeesPy script written to {out} (run: python {out})", file=sys.stderr)
+        write_text(out, text)
+    if args.json:
+        from seisrack.cli._common import print_json
+
+        print_json({"rack": args.rack, "format": "opensees", "pallets": args.pallets,
+                    "mu": args.mu, "k_init_N_m": args.k_init, "n_dof": model.n_dof,
+                    "n_pallets": model.n_pallets, "lines": text.count("\n"),
+                    "out": None if out is None else str(out),
+                    **({"script": text} if out is None else {})})
+    elif out is None:
+        sys.stdout.write(text)
+    else:
+        print(f"OpenSeesPy script written to {out} (run: python {out})", file=sys.stderr)
     return 0

@@ -38,7 +38,7 @@ def _add_options(p: argparse.ArgumentParser, defaults: bool = True) -> None:
     p.add_argument("--executor", choices=("local", "dask"), default=d("local"),
                    help="local process pool (default) or a Dask LocalCluster")
     p.add_argument("--scheduler", metavar="ADDR", default=d(None),
-                   help="address of a running Dask scheduler, e.g. tcp://10.0.0.1:8786")
+                   help="address of a running Dask scheduler, e.g. tcp://SCHEDULER-HOST:8786")
     p.add_argument("--batch-size", type=int, default=d(None), metavar="N",
                    help="runs per task (default: up to 32, fewer for small studies)")
     p.add_argument("--json", action="store_true", default=d(False), help="print one JSON object")

@@ -93,9 +93,13 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
         loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
     pallets, labels = place_pallets(loading, geometry, explicit)
+    fields = [{k: f"{lab}.{k}" for k in _PALLET_3D_KEYS} for lab in labels]
     if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
+        for p, f in zip(pallets, fields, strict=True):
+            f.update({k: f"loading.{k}" for k in footprint if getattr(p, k) is None})
         pallets = tuple(replace(p, **{k: v for k, v in footprint.items()
                                       if getattr(p, k) is None}) for p in pallets)
+    _check_footprints(pallets, fields, geometry, source)
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
@@ -251,6 +255,37 @@ def _footprint(t: Table, geom: Geometry) -> dict[str, float]:
             raise t.error("depth", depth, f"a pallet depth <= the frame depth + 2 x overhang = "
                                           f"{geom.depth:g} + 2 x {over:g} = {allowed:g} m")
     return out
+
+
+def _check_footprints(pallets: tuple[Pallet, ...], fields: list[dict[str, str]],
+                      geom: Geometry, source: str | None) -> None:
+    """Each 3D pallet rests on the front and the rear beam: its depth and overhang agree with
+    the frame depth. ``fields[i]`` names where pallet i's depth and overhang were written
+    (``pallets[3].depth`` or ``loading.depth``), so the error points at the line to change."""
+    if geom.depth is None:
+        return
+    d = geom.depth
+    for p, f in zip(pallets, fields, strict=True):
+        if p.depth is None:
+            continue
+        if p.overhang is None:
+            if p.depth <= d + _GEOM_TOL:
+                raise InputError(f["depth"], p.depth, f"a pallet deeper than the frame "
+                                 f"({d:g} m): it must rest on the front and the rear beam",
+                                 source=source, hint="Or give its overhang beyond the beams")
+            continue
+        if p.overhang >= p.depth:
+            raise InputError(f["overhang"], p.overhang,
+                             f"an overhang >= 0 and < the pallet depth {p.depth:g} m",
+                             source=source)
+        if p.depth > d + 2.0 * p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a pallet depth <= the frame depth + 2 x "
+                             f"overhang = {d:g} + 2 x {p.overhang:g} = "
+                             f"{d + 2.0 * p.overhang:g} m", source=source)
+        if p.depth <= d + p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a depth > frame depth + overhang = "
+                             f"{d + p.overhang:g} m (the pallet must reach the rear beam)",
+                             source=source)
 
 
 def _period(t: Table, key: str, value: Any) -> float:

@@ -232,6 +232,13 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
     if shear_capacity is not None and not (shear_capacity > 0):
         raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
+    from seisrack.studies.store import StoreError, check_parts
+
+    aside = check_parts(out)
+    if aside:
+        raise StoreError("; ".join(a.message() for a in aside) + f". Run the study again "
+                         f"(seisrack study STUDY.toml --out {out}) to recompute them, then "
+                         "summarise it")
     table = read_runs_table(out)
     if table.num_rows == 0:
         raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
@@ -249,7 +256,7 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         "failure_reasons": dict(reasons.most_common()),
         "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
         "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
-        "fragility": [],
+        "fragility": [], "warnings": _missing_runs(out, int(status.size)),
     }
     groups = sorted({(a, b) for a, b in zip(r["rack"], r["im_measure"], strict=True)})
     boot_store = []
@@ -274,6 +281,20 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     if write:
         _write(out / "summary", summary, plots=plots, boots=boot_store)
     return summary
+
+
+def _missing_runs(out: Path, n_stored: int) -> list[str]:
+    """A warning when the store holds fewer runs than ``study.json`` lists (an interrupted
+    study, or part files set aside): the statistics then describe part of the study."""
+    try:
+        n_planned = len(json.loads((out / "study.json").read_text(encoding="utf-8"))["runs"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    if n_stored >= n_planned:
+        return []
+    return [f"the store holds {n_stored} of the study's {n_planned} runs: the statistics "
+            f"describe part of the study; run it again (seisrack study STUDY.toml --out "
+            f"{out}) to complete it"]
 
 
 def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None:
@@ -359,7 +380,8 @@ def _fmt(x: Any, spec: str = ".3g") -> str:
 
 def format_summary(s: dict[str, Any]) -> str:
     """A readable text summary of :func:`summarize`'s result."""
-    lines = [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
+    lines = [f"warning: {w}" for w in s.get("warnings", [])]
+    lines += [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
              f"{s['runs_failed']} failed" + (f", {s['runs_skipped']} skipped (IDA stop rule)"
                                               if s.get("runs_skipped") else "")]
     for reason, n in s["failure_reasons"].items():
