@@ -22,13 +22,18 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
+    from seisrack.limits import MAX_MODES, check_modes
     from seisrack.model import compile_rack, load_rack
+    from seisrack.progress import busy
 
-    if args.modes < 1:
-        raise InputError("--modes", args.modes, "an integer >= 1")
+    if not 1 <= args.modes <= MAX_MODES:
+        raise InputError("--modes", args.modes, f"an integer from 1 to {MAX_MODES:,}")
     spec = load_rack(args.rack)
-    model = compile_rack(spec)
-    res = modal_analysis(model, args.modes)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    check_modes(args.modes, model.n_dof)
+    with busy(f"modal analysis ({model.n_dof:,} DOFs, {args.modes} modes)"):
+        res = modal_analysis(model, args.modes)
     if args.plot:
         try:
             import matplotlib  # noqa: F401

@@ -23,6 +23,7 @@ from seisrack.cli.run_inputs import (  # noqa: F401  (re-exported: report.py, te
     warn,
 )
 from seisrack.cli.run_text import format_report
+from seisrack.progress import busy
 
 #: runs with more analysis steps than this show a progress bar (when stderr is a terminal)
 PROGRESS_MIN_STEPS = 20_000
@@ -175,7 +176,10 @@ def run(args: argparse.Namespace) -> int:
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
-    model = compile_rack(spec)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    rec, vert = _records(args)
+    check_run_size(args, model, rec, vert)  # before anything is allocated
     if getattr(model, "is_3d", False):
         from seisrack.cli.run3d import run_3d
 
@@ -183,7 +187,6 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli.run3d import check_2d_options
 
     check_2d_options(args)
-    rec, vert = _records(args)
     rec, vert, scaling = _apply_scaling(args, model, rec, vert)
     _input_warnings(rec, vert, model.g, scaling is not None)
     try:
@@ -225,15 +228,35 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _progress_bar(n_steps: int) -> Any:
-    """A tqdm bar on stderr for long runs written to a terminal, else None."""
-    if n_steps <= PROGRESS_MIN_STEPS or not sys.stderr.isatty():
+    """Progress of a long run on stderr (:func:`seisrack.progress.progress`: a tqdm bar on a
+    terminal, a plain line every few seconds otherwise), or None for a short one."""
+    if n_steps <= PROGRESS_MIN_STEPS:
         return None
+    from seisrack.progress import progress
+
+    return progress(n_steps, "time history", "step")
+
+
+def check_run_size(args: argparse.Namespace, model: Any, rec: Any, vert: Any) -> None:
+    """Estimate the run's memory and time from the record length and the rack, and refuse
+    it up front when out of reach (:mod:`seisrack.limits`); announce a long one."""
+    from seisrack.analysis import analysis_grid
+    from seisrack.errors import InputError
+    from seisrack.limits import ANNOUNCE_S, check_run, estimate_run
+
     try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=n_steps, unit="step", desc="time history", file=sys.stderr,
-                leave=False, dynamic_ncols=True)
+        k = analysis_grid(rec, args.dt)
+    except InputError:
+        return  # the run reports the bad --dt itself
+    n_pad = int(round(args.free_vibration / rec.dt))
+    three_d = bool(getattr(model, "is_3d", False))
+    levels = getattr(model, "level_dofs", None) or getattr(model, "level_dofs_x", ())
+    est = estimate_run(n_record=rec.n, k=k, n_pad=n_pad, n_dof=model.n_dof,
+                       n_pallets=model.n_pallets, n_levels=max(1, len(levels)),
+                       save_every=args.save_every, vertical=vert is not None, three_d=three_d)
+    check_run(est, n_record=rec.n, n_pad=n_pad, save_every=args.save_every)
+    if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:
+        print(f"seisrack: estimated: {est.describe()} (one core)", file=sys.stderr)
 
 
 def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], out: Path,

@@ -9,6 +9,7 @@ delegated to :mod:`seisrack.cli.study_summary` with the remaining arguments.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections import Counter
 from typing import Any
@@ -44,6 +45,10 @@ def _add_options(p: argparse.ArgumentParser, defaults: bool = True) -> None:
     p.add_argument("--json", action="store_true", default=d(False), help="print one JSON object")
     p.add_argument("--no-progress", action="store_true", default=d(False),
                    help="no progress bar")
+    p.add_argument("--yes", action="store_true", default=d(False),
+                   help="run a study above the size limits (more than 100,000 runs, or "
+                        "estimated longer than 24 h on its workers); without it such a study "
+                        "is refused with its estimate")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -62,8 +67,12 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_study(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
+    from seisrack.cli.run_inputs import warn
     from seisrack.errors import InputError
+    from seisrack.limits import ANNOUNCE_S
+    from seisrack.progress import busy
     from seisrack.studies import load_study, plan, run_study
+    from seisrack.studies.size import check_study_count, check_study_time, estimate_study
 
     if args.rest:  # options after the study file
         from seisrack.cli import _Parser
@@ -79,11 +88,21 @@ def _run_study(args: argparse.Namespace) -> int:
         raise InputError("--out", None, "a folder for the study results",
                          hint="Add --out DIR (or --dry-run to see the runs)")
     spec = load_study(args.study)
-    pl = plan(spec)
+    n_runs = check_study_count(spec, args.yes)  # counted from the file: before expansion
+    with busy(f"expanding the study ({n_runs:,} runs)"):
+        pl = plan(spec)
     if args.dry_run:
         return _dry_run(args, spec, pl)
-    from seisrack.studies.store import write_study_json
+    from seisrack.studies.store import check_parts, stored_run_ids, write_study_json
 
+    for aside in check_parts(args.out):  # a damaged part: set aside, its runs run again
+        warn(aside.message() + "; they are run again")
+    workers = args.workers or (os.cpu_count() or 1)
+    done = stored_run_ids(args.out, skipped=False)
+    est = estimate_study(pl, {r.run_id for r in pl.runs if r.run_id not in done}, workers)
+    check_study_time(est, workers, args.yes, source=spec.source)
+    if est.seconds > ANNOUNCE_S:
+        print(f"seisrack: study: estimated {est.describe(workers)}", file=sys.stderr)
     write_study_json(args.out, spec, pl.runs)
     s = run_study(pl, args.out, executor=args.executor, workers=args.workers,
                   scheduler=args.scheduler, batch_size=args.batch_size,

@@ -11,6 +11,7 @@ optional ``[loading]`` table generates pallets (:mod:`seisrack.model.loading`).
 
 from __future__ import annotations
 
+import bisect
 import math
 import re
 import tomllib
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_COUNT, MAX_SUBDIVISIONS, check_rack_size, rack_size
 from seisrack.model._reader import Table, check_friction, check_number
 from seisrack.model.loading import place_pallets, read_loading
 from seisrack.model.spec import (
@@ -92,6 +94,7 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
                      lt.path, source)
         loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
+    _check_size(geometry, bracing, loading, len(explicit), source)
     pallets, labels = place_pallets(loading, geometry, explicit)
     fields = [{k: f"{lab}.{k}" for k in _PALLET_3D_KEYS} for lab in labels]
     if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
@@ -170,6 +173,9 @@ def _lengths(t: Table, key: str) -> tuple[float, ...]:
     if isinstance(value, dict):
         c = t.table(key)
         count = c.integer("count", minimum=1)
+        if count > MAX_COUNT:  # before the lengths are built
+            raise c.error("count", count, f"an integer from 1 to {MAX_COUNT:,}",
+                          hint="Model a part of the row: bays far apart behave alike")
         pitch = c.number("pitch", positive=True, unit="m")
         c.finish(("count", "pitch"))
         return (pitch,) * count
@@ -187,11 +193,50 @@ def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
         bays=bays, levels=levels,
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
         upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
-        subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
+        subdivisions=_subdivisions(t),
         depth=t.number("depth", positive=True, unit="m") if t.has("depth") else None,
     )
     t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth"))
     return geom
+
+
+def _subdivisions(t: Table) -> int:
+    n = t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1)
+    if n > MAX_SUBDIVISIONS:
+        raise t.error("subdivisions", n, f"an integer from 1 to {MAX_SUBDIVISIONS} (default "
+                      f"{DEFAULT_SUBDIVISIONS}, which converges the first modes to about 1e-4)")
+    return n
+
+
+def _check_size(geom: Geometry, bracing: Any, loading: Any, n_explicit: int,
+                source: str | None) -> None:
+    """Refuse a rack too large to build before it is meshed (or its pallets placed)."""
+    n_pallets = n_explicit
+    if loading is not None:  # an upper bound: every slot of every loaded level
+        n_pallets += (sum(1 for lv in loading.levels if loading.level_mass[lv - 1] > 0)
+                      * geom.n_bays * loading.pallets_per_bay)
+    points = 0 if bracing is None else _extra_heights(geom, bracing.panel_points)
+    size = rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
+                     three_d=geom.depth is not None, panel_points=points)
+    check_rack_size(size, n_bays=geom.n_bays, n_levels=geom.n_levels,
+                    subdivisions=geom.subdivisions,
+                    panel=None if bracing is None else f"{points} panel points",
+                    source=source)
+
+
+def _extra_heights(geom: Geometry, panel_points: tuple[float, ...]) -> int:
+    """Panel points that are not already upright nodes (the 3D mesher merges them)."""
+    if geom.n_levels * geom.subdivisions > 1_000_000:
+        return len(panel_points)  # an upper bound, without building a million heights
+    ys = (0.0, *geom.level_y)
+    nodes = sorted(ys[s] + (ys[s + 1] - ys[s]) * i / geom.subdivisions
+                   for s in range(geom.n_levels) for i in range(geom.subdivisions + 1))
+    extra = 0
+    for y in panel_points:
+        i = bisect.bisect_left(nodes, y)
+        near = [abs(nodes[j] - y) for j in (i - 1, i) if 0 <= j < len(nodes)]
+        extra += not near or min(near) > 1e-6
+    return extra
 
 
 def _spring(t: Table, key: str) -> float:

@@ -214,10 +214,9 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
 
 
 def _bar(total: int, enabled: bool):  # noqa: ANN202
+    """Progress of the runs on stderr: a tqdm bar on a terminal, plain lines otherwise."""
     if not enabled:
         return None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # tqdm is in the [io]/[all] extras
-        return None
-    return tqdm(total=total, unit="run", desc="study", dynamic_ncols=True, smoothing=0.1)
+    from seisrack.progress import progress
+
+    return progress(total, "study", "run")

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_RECORD_SAMPLES, MAX_SUITE_COUNT
 from seisrack.model._reader import Table, check_number
 from seisrack.motion.records import G
 
@@ -242,6 +243,11 @@ def _ec8(t: Table) -> EC8Suite:
                  count=t.integer("count", 7, minimum=1), seed=t.integer("seed", 0, minimum=0),
                  dt=t.number("dt", 0.01, positive=True, unit="s"))
     t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt"))
+    if s.count > MAX_SUITE_COUNT:
+        raise t.error("count", s.count, f"an integer from 1 to {MAX_SUITE_COUNT:,}")
+    if s.duration / s.dt > MAX_RECORD_SAMPLES:
+        raise t.error("duration", s.duration, f"a duration of at most {MAX_RECORD_SAMPLES:,} "
+                      f"time steps ({MAX_RECORD_SAMPLES * s.dt:g} s at dt = {s.dt:g} s)")
     return s
 
 
