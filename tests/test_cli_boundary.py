@@ -53,7 +53,7 @@ def _json_error(capsys, argv: list[str], code: int = 2) -> dict:
 
 @pytest.mark.parametrize(("err", "words"), [
     (errno.ENOSPC, "no space left"), (errno.EROFS, "read-only"),
-    (errno.EACCES, "permission denied"), (errno.ENOENT, "no such file"),
+    (errno.EACCES, "permission denied"), (errno.ENOENT, "not found"),
     (errno.EISDIR, "folder"), (errno.EIO, "input/output"),
 ])
 def test_os_errors_name_the_path(monkeypatch, capsys, tmp_path, err, words):

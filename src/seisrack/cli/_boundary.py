@@ -59,7 +59,7 @@ _OS_ERRORS: dict[int, tuple[str, str, str]] = {
                    "Check the permissions, or choose another folder (--out)"),
     errno.EPERM: ("operation not permitted", "a path you may read or write",
                   "Check the permissions, or choose another folder (--out)"),
-    errno.ENOENT: ("no such file or folder", "an existing file, or a folder that exists",
+    errno.ENOENT: ("file or folder not found", "an existing file, or a folder that exists",
                    "Check the path"),
     errno.EISDIR: ("this is a folder, a file was expected", "a file", "Give a file path"),
     errno.ENOTDIR: ("a part of the path is a file, not a folder", "a path through folders",

@@ -46,8 +46,11 @@ def run(args: argparse.Namespace) -> int:
             from seisrack.report.frame_plot import save_modes_figure
 
         save_modes_figure(model, res, args.plot)
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
+
+    warnings = plausibility_warnings(spec, model)
     if getattr(model, "is_3d", False):
-        return _report_3d(args, spec, model, res)
+        return _report_3d(args, spec, model, res, warnings)
     cum = res.mass_participation.cumsum()
     if args.json:
         print_json({
@@ -58,7 +61,7 @@ def run(args: argparse.Namespace) -> int:
             "effective_mass_x_kg": res.effective_mass_x, "total_mass_x_kg": res.total_mass_x,
             "damping_coefficients": list(model.damping_coefficients),
             "critical_load_factor": model.critical_load_factor,
-            "plot": args.plot,
+            "plot": args.plot, "warnings": warnings,
         })
         return 0
     print(f"{spec.title or args.rack}")
@@ -73,10 +76,15 @@ def run(args: argparse.Namespace) -> int:
               f"{100 * res.mass_participation[k]:>9.2f}% {100 * cum[k]:>7.2f}%")
     if args.plot:
         print(f"plot written to {args.plot}")
+    if warnings:
+        from seisrack.checks.plausibility import format_warnings
+
+        print(format_warnings(warnings).lstrip("\n"))
     return 0
 
 
-def _report_3d(args: argparse.Namespace, spec: Any, model: Any, res: Any) -> int:
+def _report_3d(args: argparse.Namespace, spec: Any, model: Any, res: Any,
+               warnings: list[dict[str, Any]]) -> int:
     """Table or JSON of a 3D rack's modes: participation down-aisle (x), cross-aisle (z) and in
     plan rotation (θ about the vertical through the plan mass centre), and each mode's class."""
     from seisrack.cli._common import print_json
@@ -98,7 +106,7 @@ def _report_3d(args: argparse.Namespace, spec: Any, model: Any, res: Any) -> int
             "total_inertia_theta_kgm2": res.total_inertia_theta,
             "plan_centre_m": list(model.plan_centre),
             "damping_coefficients": list(model.damping_coefficients),
-            "plot": args.plot,
+            "plot": args.plot, "warnings": warnings,
         })
         return 0
     print(f"{spec.title or args.rack}")
@@ -115,4 +123,8 @@ def _report_3d(args: argparse.Namespace, spec: Any, model: Any, res: Any) -> int
               f"{100 * cz[k]:>6.1f}%  {res.direction[k]}")
     if args.plot:
         print(f"plot written to {args.plot}")
+    if warnings:
+        from seisrack.checks.plausibility import format_warnings
+
+        print(format_warnings(warnings).lstrip("\n"))
     return 0

@@ -50,6 +50,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from seisrack.analysis import run_rack
     from seisrack.checks import run_design_checks
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
     from seisrack.cli._common import print_json
     from seisrack.cli.run import _apply_scaling, _records, check_run_size
     from seisrack.errors import InputError
@@ -94,6 +95,7 @@ def run(args: argparse.Namespace) -> int:
     if scaling is not None:
         summary["scaling"] = scaling
     summary["design_checks"] = checks
+    summary["warnings"] = plausibility_warnings(spec, model, summary)
     write_html_report(out, spec=spec, model=model, response=resp, record=rec, summary=summary,
                       modal=modal, checks=checks, force=args.force, design_spectrum=design,
                       rack_file=args.rack)
@@ -107,6 +109,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {c['title']}: {c['verdict']}")
         for d in checks["disagreements"]:
             print(f"  DISAGREES with the time history: {d}")
+        text = format_warnings(summary["warnings"])
+        if text:
+            print(text.lstrip("\n"))
     return 0
 
 

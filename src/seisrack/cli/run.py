@@ -218,12 +218,15 @@ def run(args: argparse.Namespace) -> int:
     if scaling is not None:
         scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
         summary["scaling"] = scaling
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
+
+    summary["warnings"] = plausibility_warnings(spec, model, summary)
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot, args.force)  # adds "outputs"
     if args.json:
         print_json(summary)
     else:
-        print(format_report(resp, spec, rec, vert, summary))
+        print(format_report(resp, spec, rec, vert, summary) + format_warnings(summary["warnings"]))
     return 0
 
 
@@ -250,9 +253,8 @@ def check_run_size(args: argparse.Namespace, model: Any, rec: Any, vert: Any) ->
         return  # the run reports the bad --dt itself
     n_pad = int(round(args.free_vibration / rec.dt))
     three_d = bool(getattr(model, "is_3d", False))
-    levels = getattr(model, "level_dofs", None) or getattr(model, "level_dofs_x", ())
     est = estimate_run(n_record=rec.n, k=k, n_pad=n_pad, n_dof=model.n_dof,
-                       n_pallets=model.n_pallets, n_levels=max(1, len(levels)),
+                       n_pallets=model.n_pallets, n_levels=max(1, len(model.level_y)),
                        save_every=args.save_every, vertical=vert is not None, three_d=three_d)
     check_run(est, n_record=rec.n, n_pad=n_pad, save_every=args.save_every)
     if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:

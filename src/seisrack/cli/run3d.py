@@ -89,12 +89,15 @@ def run_3d(args: argparse.Namespace, spec: Any, model: Any, progress_bar: Any) -
     summary = {"rack": args.rack, "title": spec.title, **resp.summary()}
     if scaling is not None:
         summary["scaling"] = scaling
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
+
+    summary["warnings"] = plausibility_warnings(spec, model, summary)  # issue 23
     if out is not None:
         _write_outputs_3d(resp, model, spec, summary, out, plot, args.force)
     if args.json:
         print_json(summary)
     else:
-        print(format_report_3d(summary))
+        print(format_report_3d(summary) + format_warnings(summary["warnings"]))
     return 0
 
 
