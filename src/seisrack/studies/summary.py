@@ -341,7 +341,8 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                 theta = math.nan if f["theta"] is None else f["theta"]
                 beta = math.nan if f["beta"] is None else f["beta"]
                 plot_fragility(im, frac, theta, beta, band=band, grid=grid, label=name,
-                               im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
+                               im_label=f"{g['im_measure'].upper()} [m/s²]",
+                               status=f.get("status"), ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
         save_figure(fig, folder / "fragility.png", dpi=120)
