@@ -9,8 +9,9 @@ lines, other delimiters) and option values, for modal, run (2D and 3D), report, 
 summary (on a sound or damaged store), export, motion generate / spectrum / check, sdof,
 validate, paper and usage errors.
 
-Each case runs ``seisrack.cli.main`` in a forked child (its own process group, with its
-stdout and stderr captured, its address space limited to a few GB) and must:
+Each case runs ``seisrack.cli.main`` in a child forked by a fresh server process
+(``fuzz_server.py``: its own process group, stdout and stderr captured, address space limited
+to a few GB) and must:
 
 - exit 0 (1 where a command reports a FAIL verdict: validate, motion check, paper, sdof), with
   valid, finite JSON under ``--json``; or exit 2 with the error contract: one paragraph
@@ -26,20 +27,14 @@ The first cases of each command run always; the rest are marked ``slow`` (CI run
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import os
-import resource
-import select
 import shutil
-import signal
+import subprocess
 import sys
-import time
-import traceback
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from fuzz_inputs import Case, all_cases, study_files
@@ -47,10 +42,8 @@ from fuzz_inputs import Case, all_cases, study_files
 CASES = all_cases()
 #: exit codes every command may return; 1 only where the command reports a FAIL verdict
 OK_CODES = (0, 2)
-#: address space of a case's process beyond what it had at the fork (a runaway is refused by
-#: the size estimates long before; this only keeps a miss from taking the machine down)
-EXTRA_ADDRESS_SPACE = 6 * 2**30
 BAD_WORDS = ("Traceback (most recent call last)", "internal error", "out of memory")
+SERVER = Path(__file__).with_name("fuzz_server.py")
 
 
 def _params() -> list:
@@ -58,30 +51,40 @@ def _params() -> list:
             for c in CASES]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def warm() -> None:
-    """Load what the cases use (numba kernels from their cache, matplotlib, pyarrow) once in
-    this process: every forked case inherits it instead of loading it again."""
-    import matplotlib
+class _Server:
+    """The fork server (``fuzz_server.py``): a fresh process that forks one child per case
+    (this pytest worker may have started OpenMP threads, after which it must not fork)."""
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot  # noqa: F401
-    import pyarrow.parquet  # noqa: F401
+    def __init__(self) -> None:
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [str(Path(__file__).resolve().parents[1] / "src"), os.environ.get("PYTHONPATH", "")]))
+        self.proc = subprocess.Popen([sys.executable, str(SERVER)], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True, env=env,
+                                     start_new_session=True)
+        ready = self.proc.stdout.readline()
+        assert json.loads(ready) == {"ready": True}, ready
 
-    from seisrack.analysis import run_rack
-    from seisrack.analysis.rack3d import run_rack_3d
-    from seisrack.model import compile_rack, load_rack
-    from seisrack.motion import Record
-    from seisrack.motion.components import combine
+    def run(self, argv: list[str], folder: Path, limit_s: float) -> dict:
+        self.proc.stdin.write(json.dumps({"argv": argv, "folder": str(folder),
+                                          "limit_s": limit_s}) + "\n")
+        self.proc.stdin.flush()
+        line = self.proc.stdout.readline()  # the server enforces the time limit
+        assert line, "the fuzz server died"
+        return json.loads(line)
 
-    ROOT = Path(__file__).resolve().parents[1] / "examples"
-    rec = Record(np.sin(np.arange(101) * 0.1) * 3.0, 0.01, name="warm")
-    for name in ("paper_rack.toml", "paper_rack_nonlinear.toml", "three_level_rack.toml"):
-        run_rack(compile_rack(load_rack(ROOT / name)), rec)
-    run_rack_3d(compile_rack(load_rack(ROOT / "paper_rack_3d.toml")),
-                combine(rec, rec, None, 0.0))
-    # not the response spectra: their numba kernels run on OpenMP threads, which a process
-    # must not have started before it forks (each case starts them itself)
+    def close(self) -> None:
+        self.proc.stdin.close()
+        try:
+            self.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+
+@pytest.fixture(scope="module")
+def server():
+    srv = _Server()
+    yield srv
+    srv.close()
 
 
 @pytest.fixture(scope="module")
@@ -116,84 +119,6 @@ def _materialise(case: Case, folder: Path, store: Path | None) -> list[str]:
         elif damage == "empty":
             shutil.rmtree(dest / "runs")
     return [a.replace("@", str(folder), 1) if a.startswith("@/") else a for a in case.argv]
-
-
-def _vm_size() -> int:
-    with open("/proc/self/status") as fh:
-        for line in fh:
-            if line.startswith("VmSize:"):
-                return int(line.split()[1]) * 1024
-    return 0
-
-
-def _child(argv: list[str], folder: Path, w: int) -> None:  # pragma: no cover - in the fork
-    code, out, err = 99, io.StringIO(), io.StringIO()
-    try:
-        os.setpgid(0, 0)
-        os.chdir(folder)
-        if sys.platform.startswith("linux"):
-            limit = _vm_size() + EXTRA_ADDRESS_SPACE
-            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-        sys.stdout, sys.stderr = out, err
-        from seisrack.cli import main
-
-        try:
-            code = main(argv)
-        except SystemExit as exc:  # argparse
-            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
-    except BaseException:  # noqa: BLE001 - reported to the parent as a crash
-        err.write(traceback.format_exc())
-        code = 98
-    try:
-        payload = json.dumps({"code": code, "out": out.getvalue(), "err": err.getvalue()})
-        data = payload.encode()
-        while data:
-            data = data[os.write(w, data):]
-    finally:
-        os._exit(0)
-
-
-def run_case(case: Case, folder: Path, store: Path | None) -> dict:
-    argv = _materialise(case, folder, store)
-    r, w = os.pipe()
-    sys.stdout.flush()
-    sys.stderr.flush()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child
-        os.close(r)
-        _child(argv, folder, w)
-    os.close(w)
-    chunks, t0, timed_out = [], time.monotonic(), False
-    while True:
-        left = case.limit_s - (time.monotonic() - t0)
-        if left <= 0:
-            timed_out = True
-            break
-        ready, _, _ = select.select([r], [], [], min(left, 1.0))
-        if ready:
-            chunk = os.read(r, 1 << 16)
-            if not chunk:
-                break
-            chunks.append(chunk)
-    os.close(r)
-    if timed_out:
-        try:
-            os.killpg(pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-    _, status = os.waitpid(pid, 0)
-    try:  # the case's own process group (pool workers): nothing may outlive it
-        os.killpg(pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
-    if timed_out:
-        return {"timed_out": True, "seconds": time.monotonic() - t0, "argv": argv}
-    raw = b"".join(chunks)
-    if not raw:
-        return {"crashed": status, "argv": argv}
-    res = json.loads(raw)
-    res.update(argv=argv, seconds=time.monotonic() - t0)
-    return res
 
 
 def _finite(obj: object) -> bool:
@@ -233,12 +158,15 @@ def check_contract(case: Case, res: dict) -> None:
 
 
 @pytest.mark.parametrize("case", _params())
-def test_fuzz_case(case: Case, tmp_path: Path, request: pytest.FixtureRequest) -> None:
+def test_fuzz_case(case: Case, tmp_path: Path, server: _Server,
+                   request: pytest.FixtureRequest) -> None:
     store = request.getfixturevalue("store") if case.store else None
-    res = run_case(case, tmp_path, store)
+    argv = _materialise(case, tmp_path, store)
+    res = server.run(argv, tmp_path, case.limit_s)
+    res["argv"] = argv
     check_contract(case, res)
     left = [str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*") if ".tmp" in p.name]
-    assert not left, f"temporary files left by {' '.join(res['argv'])}: {left}"
+    assert not left, f"temporary files left by {' '.join(argv)}: {left}"
 
 
 def test_case_count_and_determinism() -> None:

@@ -25,7 +25,8 @@ from seisrack.cli.run_inputs import (  # noqa: F401  (re-exported: report.py, te
 from seisrack.cli.run_text import format_report
 from seisrack.progress import busy
 
-#: runs with more analysis steps than this show a progress bar (when stderr is a terminal)
+#: runs with more analysis steps than this report their progress (a bar on a terminal, plain
+#: lines every few seconds otherwise: seisrack.progress)
 PROGRESS_MIN_STEPS = 20_000
 
 _OUT_HELP = (
