@@ -165,8 +165,11 @@ def test_refuses_to_overwrite_without_force(case, tmp_path):
 def test_unwritable_path_is_a_clear_error(case, tmp_path):
     from seisrack.report.html import write_html_report
 
-    with pytest.raises(InputError, match="existing folder"):
-        write_html_report(tmp_path / "no" / "such" / "r.html", **case)
+    # a missing folder is created (issue 23: as `seisrack run --out` does)
+    assert write_html_report(tmp_path / "no" / "such" / "r.html", **case).is_file()
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(InputError, match="is a file, not a folder"):
+        write_html_report(tmp_path / "afile" / "r.html", **case)
     with pytest.raises(InputError, match="folder"):
         write_html_report(tmp_path, **case)
     if os.geteuid() != 0:  # root writes anywhere

@@ -193,4 +193,5 @@ def test_study_summary_with_hazard(tmp_path: Path, capsys) -> None:  # noqa: ANN
     assert "risk per year" in capsys.readouterr().out
     bad = _write(tmp_path, "0.05,5e-2\n0.1,1.5e-2\n", measure="sa")
     assert summary_main([str(out), "--boot", "0", "--hazard", str(bad), "--json"]) == 2
-    assert "measure" in capsys.readouterr().err
+    err = json.loads(capsys.readouterr().out)["error"]  # under --json, the error is JSON
+    assert "measure" in err["field"]

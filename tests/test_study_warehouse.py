@@ -262,3 +262,21 @@ def test_dask_gives_the_same_table(stored, tmp_path: Path) -> None:
     key = lambda r: r["run_id"]  # noqa: E731
     mine = [{k: v for k, v in r.items() if k != "wall_time_s"} for r in rows]
     assert sorted(other, key=key) == sorted(mine, key=key)
+
+
+def test_a_damaged_study_json_is_named_and_rewritten(stored, tmp_path: Path) -> None:
+    """The summary names an unreadable study.json instead of failing; running the study again
+    rewrites it without running anything, and the warehouse section comes back."""
+    from seisrack.studies.summary import summarize
+
+    path, out, _ = stored
+    good = (out / "study.json").read_text()
+    try:
+        (out / "study.json").write_text("{bad")
+        s = summarize(out, n_boot=0, write=False, plots=False)
+        assert "warehouse" not in s and "study.json could not be read" in s["notes"][0]
+        r = run_study(load_study(path), out, workers=1, progress=False)
+        assert r.runs_executed == 0
+        assert "warehouse" in summarize(out, n_boot=0, write=False, plots=False)
+    finally:
+        (out / "study.json").write_text(good)

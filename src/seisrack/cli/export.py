@@ -63,13 +63,18 @@ def run(args: argparse.Namespace) -> int:
         if out.exists() and not args.force:
             raise InputError("--out", args.out, "a file that does not exist yet",
                              hint="Pass --force to overwrite it")
+    from seisrack.progress import busy
+
     spec = load_rack(args.rack)
-    model = compile_rack(spec)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
     # [hysteresis] laws: each connection spring gets the law's OpenSees material
     text = opensees_script(model, pallets=args.pallets, mu=args.mu, k_init=args.k_init,
                            source=Path(args.rack).name, hysteresis=spec.hysteresis)
     if out is not None:
-        out.write_text(text, encoding="utf-8")
+        from seisrack.atomic import write_text
+
+        write_text(out, text)
     if args.json:
         from seisrack.cli._common import print_json
 

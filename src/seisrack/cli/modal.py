@@ -22,13 +22,18 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
+    from seisrack.limits import MAX_MODES, check_modes
     from seisrack.model import compile_rack, load_rack
+    from seisrack.progress import busy
 
-    if args.modes < 1:
-        raise InputError("--modes", args.modes, "an integer >= 1")
+    if not 1 <= args.modes <= MAX_MODES:
+        raise InputError("--modes", args.modes, f"an integer from 1 to {MAX_MODES:,}")
     spec = load_rack(args.rack)
-    model = compile_rack(spec)
-    res = modal_analysis(model, args.modes)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    check_modes(args.modes, model.n_dof)
+    with busy(f"modal analysis ({model.n_dof:,} DOFs, {args.modes} modes)"):
+        res = modal_analysis(model, args.modes)
     if args.plot:
         try:
             import matplotlib  # noqa: F401
@@ -38,6 +43,9 @@ def run(args: argparse.Namespace) -> int:
         from seisrack.report.frame_plot import save_modes_figure
 
         save_modes_figure(model, res, args.plot)
+    from seisrack.checks.plausibility import plausibility_warnings
+
+    warnings = plausibility_warnings(spec, model)
     planar = model.r_z is not None  # a cross-aisle direction: z and plan-rotation terms
     cx = res.mass_participation.cumsum()
     if args.json:
@@ -50,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
             "effective_mass_x_kg": res.effective_mass_x, "total_mass_x_kg": res.total_mass_x,
             "damping_coefficients": list(model.damping_coefficients),
             "critical_load_factor": model.critical_load_factor,
-            "plot": args.plot,
+            "plot": args.plot, "warnings": warnings,
         }
         if planar:
             out.update({
@@ -92,4 +100,8 @@ def run(args: argparse.Namespace) -> int:
         print(row)
     if args.plot:
         print(f"plot written to {args.plot}")
+    if warnings:
+        from seisrack.checks.plausibility import format_warnings
+
+        print(format_warnings(warnings).lstrip("\n"))
     return 0

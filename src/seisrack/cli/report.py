@@ -7,6 +7,7 @@ modal analysis and the design checks, then write ``report.html`` and ``summary.j
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 
@@ -50,18 +51,22 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from seisrack.analysis import run_rack
     from seisrack.checks import run_design_checks
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
     from seisrack.cli._common import print_json
+    from seisrack.cli.run import check_run_size
     from seisrack.cli.run_inputs import ground_motion_from_args
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
+    from seisrack.limits import MAX_MODES, check_modes
     from seisrack.model import compile_rack, load_rack, with_friction
+    from seisrack.progress import busy
     from seisrack.report.html import check_report_path, write_html_report
     from seisrack.report.rack_io import SUMMARY_FILE, write_summary_json
 
-    if args.mu is not None and not (args.mu >= 0):
-        raise InputError("--mu", args.mu, "a friction coefficient >= 0")
-    if args.modes < 1:
-        raise InputError("--modes", args.modes, "an integer >= 1")
+    if args.mu is not None and not (math.isfinite(args.mu) and args.mu >= 0):
+        raise InputError("--mu", args.mu, "a finite friction coefficient >= 0")
+    if not 1 <= args.modes <= MAX_MODES:
+        raise InputError("--modes", args.modes, f"an integer from 1 to {MAX_MODES:,}")
     out = check_report_path(args.out, args.force, field="--out")
     summary_path = out.with_name(SUMMARY_FILE)
     if summary_path.exists() and not args.force:
@@ -74,10 +79,19 @@ def run(args: argparse.Namespace) -> int:
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu)
-    model = compile_rack(spec)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    n_modes = min(args.modes, model.n_dof)
+    check_modes(n_modes, model.n_dof)
     rec, scaling = ground_motion_from_args(args, model)
-    resp = run_rack(model, rec, rigid_companion=args.rigid_check)
-    modal = modal_analysis(model, n_modes=min(args.modes, model.n_dof))
+    for key, default in (("dt", None), ("free_vibration", 0.0), ("save_every", 1)):
+        vars(args).setdefault(key, default)  # the run's defaults, for its size estimate
+    check_run_size(args, model, rec)
+    with busy("time history" + (" and the run with rigidly held pallets"
+                                if args.rigid_check else "")):
+        resp = run_rack(model, rec, rigid_companion=args.rigid_check)
+    with busy(f"modal analysis ({model.n_dof:,} DOFs)"):
+        modal = modal_analysis(model, n_modes=n_modes)
     checks = run_design_checks(model, resp, modal=modal, spectrum=design, record=rec)
     summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
                "integration": resp.history.method, "basis": resp.history.basis}
@@ -89,6 +103,7 @@ def run(args: argparse.Namespace) -> int:
         summary["design_analysis"] = section["design"]
     if section.get("reduction") is not None:
         summary["sliding_reduction"] = section["reduction"]
+    summary["warnings"] = plausibility_warnings(spec, model, summary)
     write_html_report(out, spec=spec, model=model, response=resp, record=rec, summary=summary,
                       modal=modal, checks=checks, force=args.force, design_spectrum=design,
                       rack_file=args.rack, design_section=section)
@@ -111,6 +126,9 @@ def run(args: argparse.Namespace) -> int:
             print("  sliding / rigid peaks: " + ", ".join(
                 f"{row['quantity']} {row['ratio']:.3f}" for row in r["rows"])
                 + f" (mu/alpha = {r['mu_over_alpha']:.3f})")
+        text = format_warnings(summary["warnings"])
+        if text:
+            print(text.lstrip("\n"))
     return 0
 
 

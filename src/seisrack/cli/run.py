@@ -25,8 +25,10 @@ from seisrack.cli.run_inputs import (  # noqa: F401  (re-exported: report.py, te
     warn,
 )
 from seisrack.cli.run_text import format_report
+from seisrack.progress import busy
 
-#: runs with more analysis steps than this show a progress bar (when stderr is a terminal)
+#: runs with more analysis steps than this report their progress (a bar on a terminal, plain
+#: lines every few seconds otherwise: seisrack.progress)
 PROGRESS_MIN_STEPS = 20_000
 
 _OUT_HELP = (
@@ -161,10 +163,12 @@ def run(args: argparse.Namespace) -> int:
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
-    model = compile_rack(spec)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
     if args.method == "exact" and model.n_dir > 1:
         require("exact modal propagators (method exact)", model.ndm, "--method", args.method)
     motion, scaling = ground_motion_from_args(args, model)
+    check_run_size(args, model, motion)  # before the run allocates anything
     try:
         k = analysis_grid(motion, args.dt)
     except InputError as exc:
@@ -194,25 +198,47 @@ def run(args: argparse.Namespace) -> int:
     if scaling is not None:
         scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
         summary["scaling"] = scaling
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
+
+    summary["warnings"] = plausibility_warnings(spec, model, summary)
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot, args.force)  # adds "outputs"
     if args.json:
         print_json(summary)
     else:
-        print(format_report(resp, spec, motion, summary))
+        print(format_report(resp, spec, motion, summary) + format_warnings(summary["warnings"]))
     return 0
 
 
 def _progress_bar(n_steps: int) -> Any:
-    """A tqdm bar on stderr for long runs written to a terminal, else None."""
-    if n_steps <= PROGRESS_MIN_STEPS or not sys.stderr.isatty():
+    """Progress of a long run on stderr (:func:`seisrack.progress.progress`: a tqdm bar on a
+    terminal, a plain line every few seconds otherwise), or None for a short one."""
+    if n_steps <= PROGRESS_MIN_STEPS:
         return None
+    from seisrack.progress import progress
+
+    return progress(n_steps, "time history", "step")
+
+
+def check_run_size(args: argparse.Namespace, model: Any, motion: Any) -> None:
+    """Estimate the run's memory and time from the ground motion's length and the rack, and
+    refuse it up front when out of reach (:mod:`seisrack.limits`); announce a long one."""
+    from seisrack.analysis import analysis_grid
+    from seisrack.errors import InputError
+    from seisrack.limits import ANNOUNCE_S, check_run, estimate_run
+
     try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=n_steps, unit="step", desc="time history", file=sys.stderr,
-                leave=False, dynamic_ncols=True)
+        k = analysis_grid(motion, args.dt)
+    except InputError:
+        return  # the run reports the bad --dt itself
+    n_pad = int(round(args.free_vibration / motion.dt))
+    est = estimate_run(n_record=motion.n, k=k, n_pad=n_pad, n_dof=model.n_dof,
+                       n_pallets=model.n_pallets, n_levels=max(1, len(model.level_y)),
+                       save_every=args.save_every, vertical=motion.v is not None,
+                       three_d=model.ndm == 3)
+    check_run(est, n_record=motion.n, n_pad=n_pad, save_every=args.save_every)
+    if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:
+        print(f"seisrack: estimated: {est.describe()} (one core)", file=sys.stderr)
 
 
 def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], out: Path,

@@ -11,6 +11,7 @@ optional ``[loading]`` table generates pallets (:mod:`seisrack.model.loading`).
 
 from __future__ import annotations
 
+import bisect
 import math
 import re
 import tomllib
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_COUNT, MAX_SUBDIVISIONS, check_rack_size, rack_size
 from seisrack.model._reader import Table, check_friction, check_number
 from seisrack.model.loading import place_pallets, read_loading
 from seisrack.model.spec import (
@@ -52,7 +54,7 @@ def load_rack(path: str | Path) -> RackSpec:
     with p.open("rb") as fh:
         raw = fh.read()
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        data = tomllib.loads(raw.decode("utf-8-sig"))  # a BOM (Windows Notepad) is fine
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
     except tomllib.TOMLDecodeError as exc:
@@ -93,10 +95,15 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
                      lt.path, source)
         loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
+    _check_size(geometry, bracing, loading, len(explicit), source)
     pallets, labels = place_pallets(loading, geometry, explicit)
+    fields = [{k: f"{lab}.{k}" for k in _PALLET_3D_KEYS} for lab in labels]
     if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
+        for p, f in zip(pallets, fields, strict=True):
+            f.update({k: f"loading.{k}" for k in footprint if getattr(p, k) is None})
         pallets = tuple(replace(p, **{k: v for k, v in footprint.items()
                                       if getattr(p, k) is None}) for p in pallets)
+    _check_footprints(pallets, fields, geometry, source)
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
@@ -167,6 +174,9 @@ def _lengths(t: Table, key: str) -> tuple[float, ...]:
     if isinstance(value, dict):
         c = t.table(key)
         count = c.integer("count", minimum=1)
+        if count > MAX_COUNT:  # before the lengths are built
+            raise c.error("count", count, f"an integer from 1 to {MAX_COUNT:,}",
+                          hint="Model a part of the row: bays far apart behave alike")
         pitch = c.number("pitch", positive=True, unit="m")
         c.finish(("count", "pitch"))
         return (pitch,) * count
@@ -186,7 +196,7 @@ def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
         bays=bays, levels=levels,
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
         upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
-        subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
+        subdivisions=_subdivisions(t),
         depth=depth, rows=rows, row_spacer=spacer,
     )
     t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth",
@@ -244,6 +254,45 @@ def _rows(t: Table, top: float, depth: float | None, sections: dict[str, Section
                            "(on the uprights, above the floor)")
     st.finish(("length", "section", "spacing", "heights"))
     return 2, RowSpacer(length=length, section=section, heights=tuple(heights))
+
+
+def _subdivisions(t: Table) -> int:
+    n = t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1)
+    if n > MAX_SUBDIVISIONS:
+        raise t.error("subdivisions", n, f"an integer from 1 to {MAX_SUBDIVISIONS} (default "
+                      f"{DEFAULT_SUBDIVISIONS}, which converges the first modes to about 1e-4)")
+    return n
+
+
+def _check_size(geom: Geometry, bracing: Any, loading: Any, n_explicit: int,
+                source: str | None) -> None:
+    """Refuse a rack too large to build before it is meshed (or its pallets placed)."""
+    n_pallets = n_explicit
+    if loading is not None:  # an upper bound: every slot of every loaded level
+        n_pallets += (sum(1 for lv in loading.levels if loading.level_mass[lv - 1] > 0)
+                      * geom.n_bays * loading.pallets_per_bay * geom.rows)
+    points = 0 if bracing is None else _extra_heights(geom, bracing.panel_points)
+    size = rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
+                     three_d=geom.depth is not None, panel_points=points, rows=geom.rows)
+    check_rack_size(size, n_bays=geom.n_bays, n_levels=geom.n_levels,
+                    subdivisions=geom.subdivisions,
+                    panel=None if bracing is None else f"{points} panel points",
+                    source=source)
+
+
+def _extra_heights(geom: Geometry, panel_points: tuple[float, ...]) -> int:
+    """Panel points that are not already upright nodes (the 3D mesher merges them)."""
+    if geom.n_levels * geom.subdivisions > 1_000_000:
+        return len(panel_points)  # an upper bound, without building a million heights
+    ys = (0.0, *geom.level_y)
+    nodes = sorted(ys[s] + (ys[s + 1] - ys[s]) * i / geom.subdivisions
+                   for s in range(geom.n_levels) for i in range(geom.subdivisions + 1))
+    extra = 0
+    for y in panel_points:
+        i = bisect.bisect_left(nodes, y)
+        near = [abs(nodes[j] - y) for j in (i - 1, i) if 0 <= j < len(nodes)]
+        extra += not near or min(near) > 1e-6
+    return extra
 
 
 def _spring(t: Table, key: str) -> float:
@@ -307,6 +356,37 @@ def _footprint(t: Table, geom: Geometry) -> dict[str, float]:
             raise t.error("depth", depth, f"a pallet depth <= the frame depth + 2 x overhang = "
                                           f"{geom.depth:g} + 2 x {over:g} = {allowed:g} m")
     return out
+
+
+def _check_footprints(pallets: tuple[Pallet, ...], fields: list[dict[str, str]],
+                      geom: Geometry, source: str | None) -> None:
+    """Each 3D pallet rests on the front and the rear beam: its depth and overhang agree with
+    the frame depth. ``fields[i]`` names where pallet i's depth and overhang were written
+    (``pallets[3].depth`` or ``loading.depth``), so the error points at the line to change."""
+    if geom.depth is None:
+        return
+    d = geom.depth
+    for p, f in zip(pallets, fields, strict=True):
+        if p.depth is None:
+            continue
+        if p.overhang is None:
+            if p.depth <= d + _GEOM_TOL:
+                raise InputError(f["depth"], p.depth, f"a pallet deeper than the frame "
+                                 f"({d:g} m): it must rest on the front and the rear beam",
+                                 source=source, hint="Or give its overhang beyond the beams")
+            continue
+        if p.overhang >= p.depth:
+            raise InputError(f["overhang"], p.overhang,
+                             f"an overhang >= 0 and < the pallet depth {p.depth:g} m",
+                             source=source)
+        if p.depth > d + 2.0 * p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a pallet depth <= the frame depth + 2 x "
+                             f"overhang = {d:g} + 2 x {p.overhang:g} = "
+                             f"{d + 2.0 * p.overhang:g} m", source=source)
+        if p.depth <= d + p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a depth > frame depth + overhang = "
+                             f"{d + p.overhang:g} m (the pallet must reach the rear beam)",
+                             source=source)
 
 
 def _period(t: Table, key: str, value: Any) -> float:

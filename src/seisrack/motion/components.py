@@ -6,7 +6,7 @@ A record pair (e.g. the two horizontal components of a PEER NGA station, ``*.AT2
 as component 1 along the rack's down-aisle axis x and component 2 along its cross-aisle axis
 z; an incidence angle θ turns the pair about the vertical (from x towards z), so that
 x = a1 cos θ − a2 sin θ and z = a1 sin θ + a2 cos θ (a rotation of the plane: the horizontal
-intensity |a| is kept at every instant). Axes as :mod:`seisrack.model.frame_model3d`.
+intensity |a| is kept at every instant). Axes as :mod:`seisrack.model.frame_model`.
 """
 
 from __future__ import annotations

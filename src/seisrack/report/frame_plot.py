@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.fe.elements import rotation
 from seisrack.fe.mesh import FloatArray
 
@@ -122,6 +123,6 @@ def save_modes_figure(model: Any, modal: Any, path: str | Path, n_shapes: int = 
 
     fig = modes_figure(model, modal, n_shapes, frame=True)
     out = Path(path)
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     plt.close(fig)
     return out

@@ -333,26 +333,45 @@ def sliding_grid(resp: RackResponse) -> tuple[np.ndarray, np.ndarray, int]:
     return val, ids, n_slot
 
 
+#: share of the magma_r colour map used by the heat map: its last quarter is near black, which
+#: hid the pallet numbers and made a rack whose pallets all slid alike one black block
+HEATMAP_CMAP_TOP = 0.75
+#: peaks within this fraction of the largest count as "all alike" (said in the title)
+HEATMAP_UNIFORM_RTOL = 0.01
+
+
 def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 80) -> Any:
     """Peak sliding of every pallet on a level × (bay, slot) grid, with a colour bar [mm].
 
-    Cells are labelled with the pallet id when there are at most ``annotate`` pallets; a
-    pallet whose sliding reached its free distance is outlined in red. Returns the Axes.
+    Cells are labelled with the pallet id when there are at most ``annotate`` pallets, in
+    black or white after the cell's lightness so that they stay legible; a pallet whose
+    sliding reached its free distance is outlined in red. The colour map stops short of black
+    (:data:`HEATMAP_CMAP_TOP`), and when every pallet slid alike the title says so (a uniform
+    map is then the truth, not a failure). Returns the Axes.
     """
+    import matplotlib
+    from matplotlib.colors import ListedColormap, Normalize
+
     ax = _axes(ax)
     val, ids, n_slot = sliding_grid(resp)
     n_level, n_col = val.shape
     masked = np.ma.masked_invalid(val * 1e3)
-    im = ax.imshow(masked, origin="lower", aspect="auto", cmap="magma_r",
-                   vmin=0.0, vmax=max(float(masked.max()) if masked.count() else 0.0, 1e-3))
+    cmap = ListedColormap(matplotlib.colormaps["magma_r"](
+        np.linspace(0.0, HEATMAP_CMAP_TOP, 256)))
+    vmax = max(float(masked.max()) if masked.count() else 0.0, 1e-3)
+    norm = Normalize(vmin=0.0, vmax=vmax)
+    im = ax.imshow(masked, origin="lower", aspect="auto", cmap=cmap, norm=norm)
     ax.figure.colorbar(im, ax=ax, label="peak sliding [mm]")
     risk = set(resp.pallets_at_risk()) | {f.pallet + 1 for f in resp.falls}
     for (r, c), pid in np.ndenumerate(ids):
         if pid and pid in risk:
-            ax.add_patch(__import__("matplotlib").patches.Rectangle(
+            ax.add_patch(matplotlib.patches.Rectangle(
                 (c - 0.5, r - 0.5), 1, 1, fill=False, ec="red", lw=1.5))
         if pid and resp.n_pallets <= annotate:
-            ax.text(c, r, str(pid), ha="center", va="center", fontsize=6, color="0.5")
+            red, green, blue, _ = cmap(norm(float(masked[r, c])))
+            light = 0.299 * red + 0.587 * green + 0.114 * blue
+            ax.text(c, r, str(pid), ha="center", va="center", fontsize=6,
+                    color="black" if light > 0.5 else "white")
     n_bay = n_col // n_slot
     for b in range(1, n_bay):
         ax.axvline(b * n_slot - 0.5, color="k", lw=0.6)
@@ -364,8 +383,14 @@ def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 
                        fontsize=7)
     ax.set_xlabel(f"bay (each split in {n_slot} slot{'s' if n_slot > 1 else ''}, left to right)")
     ax.set_ylabel("beam level")
-    ax.set_title("Peak sliding of each pallet (numbers: pallet id; red: reached its free "
-                 "distance" + (" or fell" if resp.n_dir > 1 else "") + ")", fontsize=10)
+    title = ("Peak sliding of each pallet (numbers: pallet id; red: reached its free distance"
+             + (" or fell" if resp.n_dir > 1 else "") + ")")
+    if masked.count():
+        lo, hi = float(masked.min()), float(masked.max())
+        if hi - lo <= HEATMAP_UNIFORM_RTOL * max(hi, 1e-12):
+            title += (f"\nevery pallet slid alike: {hi:.3g} mm" if hi > 1e-9 else
+                      "\nno pallet slid")
+    ax.set_title(title, fontsize=10)
     return ax
 
 
@@ -456,7 +481,9 @@ def _save_plan_view(resp: RackResponse, model: Any, out: Path, suptitle: str | N
         title = fig.get_suptitle()
         fig.suptitle(f"{suptitle}\n{title}" if title else suptitle, fontsize=9)
         fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.65 / fig.get_figheight()))
-    fig.savefig(out / SLIDING_PATHS_FIGURE, dpi=120)
+    from seisrack.atomic import save_figure
+
+    save_figure(fig, out / SLIDING_PATHS_FIGURE, dpi=120)
     import matplotlib.pyplot as plt
 
     plt.close(fig)

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from seisrack.atomic import save_figure
+
 
 def save_reduction_figure(folder: Path, summary: dict[str, Any]) -> dict[str, str]:
     """One panel per group with a sliding reduction: ratio against μ/α."""
@@ -29,7 +31,7 @@ def save_reduction_figure(folder: Path, summary: dict[str, Any]) -> dict[str, st
         ax.set_title(Path(g["rack"]).name, fontsize="small")
     fig.tight_layout()
     path = folder / "sliding_reduction.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return {"sliding_reduction_png": str(path)}
 
@@ -47,6 +49,6 @@ def save_risk_figure(folder: Path, summary: dict[str, Any]) -> dict[str, str]:
 
     ax = plot_risk(summary["risk"])
     path = folder / "risk.png"
-    ax.figure.savefig(path, dpi=120, bbox_inches="tight")
+    save_figure(ax.figure, path, dpi=120, bbox_inches="tight")
     plt.close(ax.figure)
     return {"risk_png": str(path)}

@@ -55,6 +55,17 @@ _RECORDS: dict = {}
 _RIGID: dict = {}  # rigid-pallet companion peaks by (rack, occupancy, record, scale)
 _LIMITER: Any = None
 _CACHE_MAX = 128
+#: [s] how long a --scheduler address may take to answer as a Dask scheduler
+SCHEDULER_TIMEOUT_S = 15
+
+
+def _worker_init(ctx: Any, parent_pid: int) -> None:
+    """Initializer of a pool worker: follow the driver if it dies (no orphans, see
+    :mod:`seisrack.studies.lifeline`), then take the study's context."""
+    from seisrack.studies.lifeline import die_with_parent
+
+    die_with_parent(parent_pid)
+    _set_context(ctx)
 
 
 def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
@@ -320,8 +331,8 @@ class LocalExecutor:
 
         pending = deque((b, 0) for b in batches)
         while pending:
-            pool = ProcessPoolExecutor(self.workers, initializer=_set_context,
-                                       initargs=(self.ctx,))
+            pool = ProcessPoolExecutor(self.workers, initializer=_worker_init,
+                                       initargs=(self.ctx, os.getpid()))
             inflight: dict = {}
             broken: list = []
             try:
@@ -383,15 +394,24 @@ class DaskExecutor:
         cluster = None
         if self.scheduler:
             try:
-                client = Client(self.scheduler, timeout="20s")
-            except (OSError, TimeoutError, ValueError) as exc:
+                client = Client(self.scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
+            except Exception as exc:  # noqa: BLE001 - whatever answered is not a scheduler
+                # (an HTTP server's reply read as a Dask frame length asks for exabytes: a
+                # MemoryError; nothing at all: a timeout; a bad address: ValueError)
                 from seisrack.errors import InputError
 
-                raise InputError("scheduler", self.scheduler, "the address of a running Dask "
-                                 "scheduler, e.g. tcp://10.0.0.1:8786", hint=str(exc)) from None
+                why = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
+                raise InputError("--scheduler", self.scheduler, "the address of a running Dask "
+                                 "scheduler, e.g. tcp://SCHEDULER-HOST:8786",
+                                 hint=f"What is there is not a Dask scheduler, or it did not "
+                                      f"answer within {SCHEDULER_TIMEOUT_S} s "
+                                      f"({type(exc).__name__}"
+                                      + (f": {why}" if why else "") + ")") from None
         else:
+            # on the loopback interface: a local cluster is nobody else's business
             cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.WARNING)
+                                   host="127.0.0.1", dashboard_address=None,
+                                   silence_logs=logging.WARNING)
             client = Client(cluster)
         try:
             ctx = client.scatter(self.ctx, broadcast=True)

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_RECORD_SAMPLES, MAX_SUITE_COUNT
 from seisrack.model._reader import Table, check_number
 from seisrack.motion.records import G
 
@@ -186,7 +187,7 @@ def load_study(path: str | Path) -> StudySpec:
         raise InputError("study", str(p), "an existing study TOML file")
     raw = p.read_bytes()
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a BOM (Windows Notepad) is fine
         data = tomllib.loads(text)
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
@@ -358,6 +359,11 @@ def _ec8(t: Table) -> EC8Suite:
         raise t.error("components", s.components, "1 (one horizontal component) or 2 (a pair, "
                       "for 3D racks)")
     t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt", "components"))
+    if s.count > MAX_SUITE_COUNT:
+        raise t.error("count", s.count, f"an integer from 1 to {MAX_SUITE_COUNT:,}")
+    if s.duration / s.dt > MAX_RECORD_SAMPLES:
+        raise t.error("duration", s.duration, f"a duration of at most {MAX_RECORD_SAMPLES:,} "
+                      f"time steps ({MAX_RECORD_SAMPLES * s.dt:g} s at dt = {s.dt:g} s)")
     return s
 
 

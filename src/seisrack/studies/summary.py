@@ -25,19 +25,18 @@ Theta is in the units of the intensity measure as stored: m/s² for both PGA and
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import logging
 import math
-import sys
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from seisrack.errors import InputError, SeisrackError
+from seisrack.atomic import atomic_write, save_figure, write_text
+from seisrack.errors import InputError
 from seisrack.studies import fragility as fr
 from seisrack.studies.reduction_summary import COLUMNS as REDUCTION_COLUMNS
 from seisrack.studies.reduction_summary import format_reduction, reduction_summary
@@ -257,6 +256,13 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
     if shear_capacity is not None and not (shear_capacity > 0):
         raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
+    from seisrack.studies.store import StoreError, check_parts
+
+    aside = check_parts(out)
+    if aside:
+        raise StoreError("; ".join(a.message() for a in aside) + f". Run the study again "
+                         f"(seisrack study STUDY.toml --out {out}) to recompute them, then "
+                         "summarise it")
     table = read_runs_table(out)
     if table.num_rows == 0:
         raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
@@ -280,7 +286,7 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         "failure_reasons": dict(reasons.most_common()),
         "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
         "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
-        "fragility": [],
+        "fragility": [], "warnings": _missing_runs(out, int(status.size)),
     }
     groups = sorted({(a, b) for a, b in zip(r["rack"], r["im_measure"], strict=True)})
     boot_store = []
@@ -317,7 +323,11 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     from seisrack.studies.warehouse_summary import warehouse_groups, warehouse_summary
 
     wh = warehouse_groups(out)
-    if wh is not None:
+    if wh is not None and "unreadable" in wh:
+        summary["notes"] = [wh["unreadable"] + ": if the study is of a warehouse, its section "
+                            "is missing; run the study command again to rewrite the file "
+                            "(nothing is rerun)"]
+    elif wh is not None:
         summary["warehouse"] = {**warehouse_summary(r, wh), "path": wh.get("path")}
         if hazard is not None:
             from seisrack.studies.warehouse_summary import annual_falls
@@ -330,15 +340,33 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     return summary
 
 
+def _missing_runs(out: Path, n_stored: int) -> list[str]:
+    """A warning when the store holds fewer runs than ``study.json`` lists (an interrupted
+    study, or part files set aside): the statistics then describe part of the study."""
+    try:
+        n_planned = len(json.loads((out / "study.json").read_text(encoding="utf-8"))["runs"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    if n_stored >= n_planned:
+        return []
+    return [f"the store holds {n_stored} of the study's {n_planned} runs: the statistics "
+            f"describe part of the study; run it again (seisrack study STUDY.toml --out "
+            f"{out}) to complete it"]
+
+
 def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     files = {"summary_json": str(folder / "summary.json"),
              "fragility_csv": str(folder / "fragility.csv")}
-    with open(folder / "fragility.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
-        w.writeheader()
-        for row in summary["fragility"]:
-            w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in w.fieldnames})
+    def write_csv(path: Path) -> None:
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
+            w.writeheader()
+            for row in summary["fragility"]:
+                w.writerow({k: ("" if row.get(k) is None else row.get(k))
+                            for k in w.fieldnames})
+
+    atomic_write(folder / "fragility.csv", write_csv)
     if plots:
         files.update(_figures(folder, summary, boots))
         if "warehouse" in summary:
@@ -347,8 +375,8 @@ def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None
             files.update(plan_figures(folder, summary["warehouse"],
                                       summary["warehouse"].get("path")))
     summary["files"] = files
-    (folder / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1,
-                                                    allow_nan=False))
+    write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=1,
+                                                   allow_nan=False))
 
 
 def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
@@ -375,10 +403,11 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                 theta = math.nan if f["theta"] is None else f["theta"]
                 beta = math.nan if f["beta"] is None else f["beta"]
                 plot_fragility(im, frac, theta, beta, band=band, grid=grid, label=name,
-                               im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
+                               im_label=f"{g['im_measure'].upper()} [m/s²]",
+                               status=f.get("status"), ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "fragility.png", dpi=120)
+        save_figure(fig, folder / "fragility.png", dpi=120)
         plt.close(fig)
         files["fragility_png"] = str(folder / "fragility.png")
     ida = [g for g in summary["groups"] if "ida" in g]
@@ -389,7 +418,7 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                      threshold=summary["d_slide_m"][0], ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "ida.png", dpi=120)
+        save_figure(fig, folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
     from seisrack.report.study_figures import save_reduction_figure, save_risk_figure
@@ -418,7 +447,8 @@ def _fmt(x: Any, spec: str = ".3g") -> str:
 
 def format_summary(s: dict[str, Any]) -> str:
     """A readable text summary of :func:`summarize`'s result."""
-    lines = [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
+    lines = [f"warning: {w}" for w in s.get("warnings", [])]
+    lines += [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
              f"{s['runs_failed']} failed" + (f", {s['runs_skipped']} skipped (IDA stop rule)"
                                               if s.get("runs_skipped") else "")]
     for reason, n in s["failure_reasons"].items():
@@ -467,6 +497,7 @@ def format_summary(s: dict[str, Any]) -> str:
         from seisrack.studies.risk import format_risk
 
         lines += format_risk(s["risk"])
+    lines += [f"\nnote: {n}" for n in s.get("notes", [])]
     if "warehouse" in s:
         from seisrack.studies.warehouse_summary import format_warehouse
 
@@ -477,56 +508,8 @@ def format_summary(s: dict[str, Any]) -> str:
 
 
 def summary_main(argv: list[str]) -> int:
-    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]
-    [--report FILE.html [--force]]``."""
-    p = argparse.ArgumentParser(prog="seisrack study summary",
-                                description="Summarise a study: counts, EC8 means, fragility.")
-    p.add_argument("dir", help="the study output folder (--out of `seisrack study`)")
-    p.add_argument("--d-slide", type=float, nargs="+", default=list(DEFAULT_D_SLIDE),
-                   metavar="D", help="sliding thresholds [m] (default 0.05)")
-    p.add_argument("--shear-capacity", type=float, default=None, metavar="N",
-                   help="base shear capacity [N] for the 'base shear > capacity' state")
-    p.add_argument("--boot", type=int, default=200, metavar="N", help="bootstrap resamples")
-    p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
-    p.add_argument("--no-plots", action="store_true", help="skip the figures")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--hazard", metavar="FILE.csv", default=None,
-                   help="site hazard curve (CSV: '# measure = pga', '# units = g', then "
-                        "im,annual_frequency): mean annual frequency and 50-year probability "
-                        "of each fragility")
-    p.add_argument("--report", metavar="FILE.html", default=None,
-                   help="also write the study's self-contained HTML report")
-    p.add_argument("--force", action="store_true", help="overwrite an existing --report")
-    try:
-        a = p.parse_args(argv)
-    except SystemExit as exc:  # argparse already printed its usage message
-        return int(exc.code or 0)
-    if a.boot < 0:
-        print("error: --boot must be >= 0", file=sys.stderr)
-        return 2
-    boots: list = []
-    try:
-        if a.report:  # refuse an existing report before any work
-            from seisrack.report.html import check_report_path
+    """``seisrack study summary DIR ...`` (see :mod:`seisrack.cli.study_summary`), with the
+    command line's error contract: exit 2 and one paragraph (a JSON object under ``--json``)."""
+    from seisrack.cli import main
 
-            check_report_path(a.report, a.force, field="--report")
-        s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
-                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots,
-                      hazard=a.hazard)
-        if a.report:
-            from seisrack.report.html import write_study_report
-
-            html = write_study_report(a.report, _jsonable(s), out_dir=a.dir, boots=boots,
-                                      seed=a.seed, force=a.force)
-            s.setdefault("files", {})["report_html"] = str(html)
-    except SeisrackError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (OSError, ImportError, ValueError) as exc:  # unreadable part files
-        print(f"error: could not read the study in {a.dir}: {exc}", file=sys.stderr)
-        return 2
-    if a.json:
-        print(json.dumps(_jsonable(s), allow_nan=False))
-    else:
-        print(format_summary(s))
-    return 0
+    return main(["study", "summary", *argv])

@@ -29,11 +29,20 @@ from seisrack.studies.store import STUDY_JSON
 
 
 def warehouse_groups(out_dir: str | Path) -> dict[str, Any] | None:
-    """The ``warehouse`` entry of ``study.json`` (None for a study of racks)."""
+    """The ``warehouse`` entry of ``study.json`` (None for a study of racks). A study.json
+    that cannot be read gives ``{"unreadable": reason}``: the summary says so (running the
+    study again rewrites the file and resumes with nothing to run)."""
     p = Path(out_dir) / STUDY_JSON
     if not p.is_file():
         return None
-    return json.loads(p.read_text()).get("warehouse")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+        wh = doc.get("warehouse")
+        if wh is not None and not (isinstance(wh, dict) and isinstance(wh.get("groups"), list)):
+            raise ValueError("its 'warehouse' entry is not a table of groups")
+    except (OSError, ValueError, AttributeError) as exc:
+        return {"unreadable": f"{p} could not be read ({type(exc).__name__}: {exc})"}
+    return wh
 
 
 def warehouse_summary(r: dict[str, np.ndarray], wh: dict[str, Any]) -> dict[str, Any]:
@@ -157,10 +166,12 @@ def plan_figures(folder: Path, s: dict[str, Any], wh_path: str | None) -> dict[s
     """The plans of :func:`plan_axes` as ``warehouse_plan_<k>.png``."""
     import matplotlib.pyplot as plt
 
+    from seisrack.atomic import save_figure
+
     files = {}
     for k, ax in enumerate(plan_axes(s, wh_path)):
         path = folder / f"warehouse_plan_{k}.png"
-        ax.figure.savefig(path, dpi=110, bbox_inches="tight")
+        save_figure(ax.figure, path, dpi=110, bbox_inches="tight")
         plt.close(ax.figure)
         files[f"warehouse_plan_{k}"] = str(path)
     return files

@@ -22,7 +22,8 @@ __all__ = ["build_html", "build_study_html", "write_html_report", "write_study_r
 
 def check_report_path(path: str | os.PathLike[str], force: bool = False,
                       field: str = "path") -> Path:
-    """Refuse an existing report without ``force`` and an unwritable place, before any work."""
+    """Refuse an existing report without ``force`` and an unwritable place, before any work;
+    create the report's folder if needed."""
     p = Path(path)
     if p.is_dir():
         raise InputError(field, str(p), "a file name for the HTML report (this is a folder)")
@@ -30,9 +31,14 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
         raise InputError(field, str(p), "a path that does not exist yet",
                          hint="The report exists; pass force=True (--force) to overwrite it")
     parent = p.parent if str(p.parent) else Path(".")
-    if not parent.is_dir():
-        raise InputError(field, str(p), "a path in an existing folder",
-                         hint=f"Create the folder {parent} first")
+    if parent.exists() and not parent.is_dir():
+        raise InputError(field, str(p), "a path in a folder",
+                         hint=f"{parent} is a file, not a folder")
+    try:  # created if needed, as `seisrack run --out DIR` does
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(field, str(p), "a path in a folder that can be created",
+                         hint=f"{parent}: {exc.strerror or exc}") from None
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise InputError(field, str(p), "a writable path",
                          hint=f"Permission denied in {parent}")
@@ -42,12 +48,11 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
 def write_atomically(p: Path, text: str) -> Path:
     """Write ``text`` to a temporary file beside ``p``, then rename it: a reader never sees a
     half-written report, and a failed write leaves what was there."""
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    from seisrack.atomic import write_text
+
     try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, p)
+        write_text(p, text)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         raise InputError("path", str(p), "a writable path",
                          hint=str(exc.strerror or exc)) from None
     return p

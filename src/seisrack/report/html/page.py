@@ -334,4 +334,16 @@ def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: di
             f"<style>{CSS}</style>{head}</head><body>"
             f"<h1>Earthquake response of {esc(title)}</h1>"
             f'<p class="summary-line">Record {esc(motion.name)}: {esc(verdict)}.</p>'
-            + "".join(sec) + "</body></html>\n")
+            + _warnings_html(summary.get("warnings") or []) + "".join(sec)
+            + "</body></html>\n")
+
+
+def _warnings_html(warnings: list[dict[str, Any]]) -> str:
+    """The plausibility warnings (:mod:`seisrack.checks.plausibility`), first thing a reader
+    sees after the verdict."""
+    if not warnings:
+        return ""
+    items = "".join(f'<li data-code="{esc(w.get("code", ""))}">{esc(w["message"])} '
+                    f'<i>({esc(w.get("source", ""))})</i></li>' for w in warnings)
+    return (f'<div class="disagree" id="warnings"><b>Plausibility warnings: a reviewer would '
+            f"question these results.</b><ul>{items}</ul></div>")
