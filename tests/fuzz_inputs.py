@@ -416,6 +416,98 @@ def all_cases(seed: int = SEED) -> list[Case]:
                 ["export", "opensees"], ["motion"], ["motion", "generate"], ["sdof"],
                 ["validate", "--nope"], ["paper", "--jobs", "x"], ["study", "summary"]):
         add("usage", [*cmd, *_json(rng)], [("rack.toml", b"")], slow=False)
+    cases += _cases_3d(random.Random(seed + 1), rec)
+    return cases
+
+
+# ------------------------------------------------------------------- 3D racks, design, warehouse
+STUDY_3D = {"title": "fuzz 3D", "racks": ["rack3d.toml"], "seed": 3, "dt": 0.01,
+            "records": {"ec8": [{"type": 1, "ground": "C", "ag": 0.3, "duration": 2.0,
+                                 "count": 1, "seed": 1, "components": 2}]},
+            "intensity": {"measure": "pga", "unit": "g", "stripes": [0.3]},
+            "angle": {"values": [0.0, 90.0]},
+            "friction": {"values": [0.3]}}
+SITE = {"title": "fuzz site",
+        "rows": [{"name": "A", "rack": "rack3d.toml", "count": 2, "orientation": 0.0,
+                  "origin": [0.0, 0.0], "spacing": [0.0, 4.0]},
+                 {"name": "B", "rack": "rack.toml", "count": 1, "orientation": 90.0,
+                  "origin": [20.0, 0.0], "spacing": [-4.0, 0.0], "depth": 1.0}]}
+STUDY_SITE = {**{k: v for k, v in STUDY_3D.items() if k not in ("racks", "angle")},
+              "title": "fuzz warehouse", "warehouse": "site.toml"}
+
+
+def _cases_3d(rng: random.Random, rec: bytes) -> list[Case]:
+    """3D runs and reports (a cross-aisle record, an angle), the design analysis on 2D and 3D
+    racks, 3D and warehouse studies: appended with their own random stream, so that the cases
+    above keep theirs."""
+    cases: list[Case] = []
+
+    def add(name: str, argv: list[str], files=(), **kw: Any) -> None:
+        n = len([c for c in cases if c.name.startswith(name + "-")])
+        cases.append(Case(f"{name}-{n}", tuple(argv), tuple(files), **kw))
+
+    rack3d = (EXAMPLES / "paper_rack_3d.toml").read_bytes()
+    cross = record_csv(seed=7, amp=2.0)
+    for i in range(10):  # 3D run: the rack, either record or the angle mutated
+        what = rng.choice(("rack", "record", "cross", "angle"))
+        files = [("rack.toml", _rack(rng, ("paper_rack_3d.toml",)) if what == "rack"
+                  else rack3d), ("rec.csv", mutate_record(rng, rec) if what == "record"
+                                 else rec),
+                 ("cross.csv", mutate_record(rng, cross) if what == "cross" else cross)]
+        argv = ["run", "@/rack.toml", "--motion", "@/rec.csv", "--motion-cross",
+                "@/cross.csv", *_json(rng)]
+        if what == "angle" or rng.random() < 0.3:
+            argv += ["--angle", rng.choice(OPTION_VALUES) if what == "angle" else "30"]
+        if rng.random() < 0.3:
+            argv += ["--out", "@/out/run3d"]
+        add("run3d", argv, files, slow=i >= 3)
+    for i in range(3):  # 3D report
+        what = rng.choice(("rack", "record", "option"))
+        files = [("rack.toml", _rack(rng, ("paper_rack_3d.toml",)) if what == "rack"
+                  else rack3d), ("rec.csv", mutate_record(rng, rec) if what == "record"
+                                 else rec), ("cross.csv", cross)]
+        argv = ["report", "@/rack.toml", "--motion", "@/rec.csv", "--motion-cross",
+                "@/cross.csv", "--modes", "2", "--out", "@/out/rep3d/report.html",
+                *_json(rng)]
+        if what == "option":
+            argv += rng.choice((["--ec8", "1", "C", _opt(rng, "0.3")],
+                                ["--angle", _opt(rng, "45")], ["--mu", _opt(rng, "0.3")]))
+        add("report3d", argv, files, limit_s=150.0, slow=i >= 1)
+    for i in range(12):  # design analysis: 2D and 3D racks, mutated racks and options
+        q = ["2", "1.5"] if rng.random() < 0.5 else ["2"]
+        argv = ["design", "@/rack.toml", "--ec8", rng.choice(("1", "1", "2", "3")),
+                rng.choice(("C", "C", "A", "Z")), _opt(rng, "0.3"), "--q",
+                *[_opt(rng, v) for v in q], *_json(rng)]
+        for opt, good in rng.sample((("--importance", "1.2"), ("--damping", "model"),
+                                     ("--combination", "cqc"), ("--directions-rule", "0.30"),
+                                     ("--modes", "6"), ("--factors", "e_d1=1.0"),
+                                     ("--direction", "cross-aisle")), rng.randint(0, 2)):
+            argv += [opt, _opt(rng, good)]
+        if rng.random() < 0.15:
+            argv.append("--elastic")
+        add("design", argv, [("rack.toml", _rack(rng))], exit_1_ok=True, slow=i >= 4)
+    paper = (EXAMPLES / "paper_rack.toml").read_bytes()
+    for i in range(4):  # 3D study: record pairs and angles
+        what = rng.choice(("study", "study", "rack"))
+        study = mutate_tree(rng, STUDY_3D, rng.randint(1, 2)) if what == "study" else STUDY_3D
+        rk = _rack(rng, ("paper_rack_3d.toml",)) if what == "rack" else rack3d
+        add("study3d", ["study", "@/study.toml", "--out", "@/out/st3d", "--workers", "1",
+                        "--no-progress", *_json(rng)],
+            [("study.toml", dump_toml(study).encode()), ("rack3d.toml", rk)],
+            limit_s=150.0, slow=i >= 1)
+    for i in range(4):  # warehouse study: the study, the site or a rack mutated
+        what = rng.choice(("study", "site", "site", "rack"))
+        study = mutate_tree(rng, STUDY_SITE, 1) if what == "study" else STUDY_SITE
+        site = mutate_tree(rng, SITE, rng.randint(1, 2)) if what == "site" else SITE
+        rk = _rack(rng, ("paper_rack_3d.toml",)) if what == "rack" else rack3d
+        argv = ["study", "@/study.toml", "--out", "@/out/wh", "--workers", "1",
+                "--no-progress", *_json(rng)]
+        if rng.random() < 0.5:
+            argv.append("--dry-run")
+        add("warehouse", argv, [("study.toml", dump_toml(study).encode()),
+                                ("site.toml", dump_toml(site).encode()),
+                                ("rack3d.toml", rk), ("rack.toml", paper)],
+            limit_s=150.0, slow=i >= 1)
     return cases
 
 

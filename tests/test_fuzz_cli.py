@@ -5,9 +5,10 @@ The cases (:mod:`fuzz_inputs`, derandomized: one fixed seed) mutate the examples
 study TOMLs (keys deleted, values replaced by zeros, negatives, huge, tiny, non-finite or
 wrongly typed values, lists emptied or doubled, bytes truncated, BOMs, invalid UTF-8), record
 files (non-finite or non-numeric samples, broken time columns, wrong column counts, too few
-lines, other delimiters) and option values, for modal, run (2D and 3D), report, study, study
-summary (on a sound or damaged store), export, motion generate / spectrum / check, sdof,
-validate, paper and usage errors.
+lines, other delimiters) and option values, for modal, run and report (2D, and 3D with a
+cross-aisle record and an angle), design (2D and 3D), study (2D, 3D record pairs with angles,
+a warehouse site file), study summary (on a sound or damaged store), export, motion generate /
+spectrum / check, sdof, validate, paper and usage errors.
 
 Each case runs ``seisrack.cli.main`` in a child forked by a fresh server process
 (``fuzz_server.py``: its own process group, stdout and stderr captured, address space limited
@@ -177,8 +178,12 @@ def test_case_count_and_determinism() -> None:
                                                           for c in CASES]
     commands = {c.argv[0] if c.argv[0] not in ("motion", "study") else
                 " ".join(c.argv[:2]) for c in CASES}
-    for cmd in ("modal", "run", "report", "export", "sdof", "validate", "paper",
+    for cmd in ("modal", "run", "report", "export", "sdof", "validate", "paper", "design",
                 "motion generate", "motion spectrum", "motion check", "study summary"):
         assert cmd in commands, cmd
+    # 3D racks: runs and reports with a cross-aisle record, studies of pairs, a warehouse
+    assert any(c.argv[0] in ("run", "report") and "--motion-cross" in c.argv for c in CASES)
+    assert any(c.name.startswith("study3d") for c in CASES)
+    assert any(c.name.startswith("warehouse") for c in CASES)
     assert any(c.argv[0] == "study" and c.argv[1] != "summary" for c in CASES)
     assert len(CASES) >= 200
