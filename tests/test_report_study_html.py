@@ -24,8 +24,7 @@ import pytest
 pytest.importorskip("pyarrow")
 pytest.importorskip("matplotlib")
 
-from seisrack.studies.summary import summary_main  # noqa: E402
-from test_study_summary import _row, _write  # noqa: E402
+from test_study_summary import _row, _write, summary_main  # noqa: E402
 
 G = 9.80665
 IMS = (1.0, 2.0, 3.0, 4.0)  # [m/s²]

@@ -170,7 +170,7 @@ def _store(tmp: Path) -> Path:
 def test_study_summary_with_hazard(tmp_path: Path, capsys) -> None:  # noqa: ANN001
     """``study summary --hazard``: λ of each fitted fragility equals annual_rate on the same
     curve (and its P50), the figure is written, a wrong measure is refused (exit 2)."""
-    from seisrack.studies.summary import summary_main
+    from test_study_summary import summary_main
 
     out = _store(tmp_path / "study")
     haz = _write(tmp_path, "0.05,5e-2\n0.1,1.5e-2\n0.2,3e-3\n0.4,4e-4\n0.8,3e-5\n")

@@ -23,8 +23,15 @@ import pytest
 pa = pytest.importorskip("pyarrow")
 pq = pytest.importorskip("pyarrow.parquet")
 
+from seisrack.cli import main  # noqa: E402
 from seisrack.studies import fragility as fr  # noqa: E402
-from seisrack.studies.summary import summarize, summary_main  # noqa: E402
+from seisrack.studies.summary import summarize  # noqa: E402
+
+
+def summary_main(argv: list[str]) -> int:
+    """``seisrack study summary ARGV`` through the command line's error boundary."""
+    return main(["study", "summary", *argv])
+
 
 IMS = (1.0, 2.0, 3.0, 4.0)  # [m/s²]
 N_REC, N_MU = 8, 2

@@ -160,18 +160,18 @@ def rack_size(n_bays: int, n_levels: int, subdivisions: int, n_pallets: int, *,
 
 
 def check_rack_size(size: RackSize, *, n_bays: int, n_levels: int, subdivisions: int,
-                    panel: Any = None, source: str | None = None) -> None:
-    """Refuse a rack above :data:`MAX_RACK_DOFS`, naming what makes it large."""
+                    default_subdivisions: int, panel: Any = None, source: str | None = None
+                    ) -> None:
+    """Refuse a rack above :data:`MAX_RACK_DOFS`, naming what makes it large (the
+    subdivisions when the rack would fit with ``default_subdivisions``, the model's default)."""
     if size.dofs <= MAX_RACK_DOFS:
         return
     parts = {"bracing.panel": size.bracing, "pallets": size.pallets,
              "frame": size.uprights + size.beams}
     culprit = max(parts, key=parts.get)
-    from seisrack.model.spec import DEFAULT_SUBDIVISIONS
-
     if culprit == "frame":
-        lighter = rack_size(n_bays, n_levels, DEFAULT_SUBDIVISIONS, 0).dofs
-        if subdivisions > DEFAULT_SUBDIVISIONS and lighter <= MAX_RACK_DOFS:
+        lighter = rack_size(n_bays, n_levels, default_subdivisions, 0).dofs
+        if subdivisions > default_subdivisions and lighter <= MAX_RACK_DOFS:
             field, value = "geometry.subdivisions", subdivisions
         elif n_bays >= n_levels:
             field, value = "geometry.bays", f"{n_bays} bays"

@@ -68,9 +68,12 @@ def run(argv: list[str]) -> int:
                   seed=a.seed, plots=not a.no_plots, boots=boots, hazard=a.hazard)
     if a.report:
         from seisrack.report.html import write_study_report
+        from seisrack.studies.warehouse_summary import plan_axes
 
+        wh = s.get("warehouse") or {}
+        plans = plan_axes(wh, wh.get("path")) if wh else []
         html = write_study_report(a.report, _jsonable(s), out_dir=a.dir, boots=boots,
-                                  seed=a.seed, force=a.force)
+                                  seed=a.seed, force=a.force, plans=plans)
         s.setdefault("files", {})["report_html"] = str(html)
     if a.json:
         print_json(_jsonable(s))

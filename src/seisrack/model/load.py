@@ -275,6 +275,7 @@ def _check_size(geom: Geometry, bracing: Any, loading: Any, n_explicit: int,
     size = rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
                      three_d=geom.depth is not None, panel_points=points, rows=geom.rows)
     check_rack_size(size, n_bays=geom.n_bays, n_levels=geom.n_levels,
+                    default_subdivisions=DEFAULT_SUBDIVISIONS,
                     subdivisions=geom.subdivisions,
                     panel=None if bracing is None else f"{points} panel points",
                     source=source)

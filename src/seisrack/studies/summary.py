@@ -41,7 +41,7 @@ from seisrack.studies import fragility as fr
 from seisrack.studies.reduction_summary import COLUMNS as REDUCTION_COLUMNS
 from seisrack.studies.reduction_summary import format_reduction, reduction_summary
 
-__all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
+__all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize"]
 
 log = logging.getLogger(__name__)
 
@@ -505,11 +505,3 @@ def format_summary(s: dict[str, Any]) -> str:
     if "files" in s:
         lines.append("\nwritten: " + ", ".join(s["files"].values()))
     return "\n".join(lines)
-
-
-def summary_main(argv: list[str]) -> int:
-    """``seisrack study summary DIR ...`` (see :mod:`seisrack.cli.study_summary`), with the
-    command line's error contract: exit 2 and one paragraph (a JSON object under ``--json``)."""
-    from seisrack.cli import main
-
-    return main(["study", "summary", *argv])

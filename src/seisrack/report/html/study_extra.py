@@ -12,8 +12,9 @@ from typing import Any
 
 from seisrack.report.html import figures as F
 from seisrack.report.html.page import _figure
-from seisrack.report.html.study_page import _cell, _table
 from seisrack.report.html.tables import esc
+from seisrack.report.html.tables import path_cell as _cell
+from seisrack.report.html.tables import table as _table
 
 G = 9.80665  # [m/s²]
 _Q = ("base_shear", "connector_moment", "upright_moment")
@@ -106,8 +107,9 @@ def risk_section(summary: dict[str, Any], number: int) -> str:
             + "</section>")
 
 
-def warehouse_section(summary: dict[str, Any], number: int) -> str:
-    """``<section id="warehouse">`` or "" for a study of racks (``warehouse = ...``)."""
+def warehouse_section(summary: dict[str, Any], number: int, plans: list[Any] = ()) -> str:
+    """``<section id="warehouse">`` or "" for a study of racks (``warehouse = ...``); ``plans``:
+    one plan (matplotlib Axes) per intensity level, drawn by the caller."""
     wh = summary.get("warehouse")
     if not wh:
         return ""
@@ -137,14 +139,10 @@ def warehouse_section(summary: dict[str, Any], number: int) -> str:
                 "stronger than the highest stripe's bin, counted at the highest stripe "
                 "(FEMA P-58-1 §8.2).</p>")
     figs = ""
-    path = wh.get("path")
-    if path:
-        from seisrack.studies.warehouse_summary import plan_axes
-
-        for li, ax in enumerate(plan_axes(wh, path)):
-            figs += _figure(f"fig-warehouse-{li}", F.png_data_uri(ax.figure),
-                            f"Plan at IM {wh['levels'][li]['im'] / G:.3f} g: each row coloured "
-                            "by the probability that it loses a pallet (arrow: down-aisle).")
+    for li, ax in enumerate(plans):
+        figs += _figure(f"fig-warehouse-{li}", F.png_data_uri(ax.figure),
+                        f"Plan at IM {wh['levels'][li]['im'] / G:.3f} g: each row coloured "
+                        "by the probability that it loses a pallet (arrow: down-aisle).")
     return (f'<section id="warehouse"><h2>{number}. The warehouse</h2>'
             f"<p>{wh['n_rows']} rows, {wh['n_pallets']} pallets ({esc(wh.get('file', ''))}). "
             "Identical rows see the same motion; a group's expected falls are its number of "

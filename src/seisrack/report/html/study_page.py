@@ -25,7 +25,9 @@ from seisrack import __version__
 from seisrack.report.html import figures as F
 from seisrack.report.html.page import _figure
 from seisrack.report.html.style import CSS
-from seisrack.report.html.tables import _unit_factor, esc, header_of, num_cell
+from seisrack.report.html.tables import _unit_factor, esc, header_of
+from seisrack.report.html.tables import path_cell as _cell
+from seisrack.report.html.tables import table as _table
 
 __all__ = ["STATUS_NOTES", "build_study_html", "read_study_json", "write_study_report"]
 
@@ -50,20 +52,6 @@ PEAK_LABELS = {"peak_sliding_max_m": "peak pallet sliding", "n_fall": "pallets a
                "falling", "base_shear_N": "base shear", "beam_displacement_max_m":
                "beam displacement", "drift_ratio_max": "interstorey drift ratio",
                "upright_moment_connection_Nm": "upright moment at the connection"}
-
-
-def _cell(path: list[Any], value: Any, factor: float = 1.0, fmt: str = "{:.4g}") -> str:
-    """A number cell with ``data-path`` (its place in summary.json) and ``data-value``."""
-    dp = f'data-path="{esc(json.dumps(path))}"'
-    if value is None:
-        return f'<td class="num" {dp} data-key="{esc(path[-1])}" data-value="null">–</td>'
-    return num_cell(value, factor, fmt, str(path[-1])).replace("<td ", f"<td {dp} ", 1)
-
-
-def _table(tid: str, headers: list[str], rows: list[str], caption: str) -> str:
-    head = "".join(f"<th>{esc(h)}</th>" for h in headers)
-    return (f'<table id="{esc(tid)}"><caption>{esc(caption)}</caption><thead><tr>{head}</tr>'
-            f"</thead><tbody>{''.join(rows)}</tbody></table>")
 
 
 def read_study_json(out_dir: str | os.PathLike[str]) -> dict[str, Any] | None:
@@ -336,7 +324,8 @@ def _parameters(summary: dict[str, Any]) -> str:
 
 
 def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = None,
-                     boots: Any = None, seed: int | None = None, date: str = "") -> str:
+                     boots: Any = None, seed: int | None = None, date: str = "",
+                     plans: list[Any] = ()) -> str:
     """The study report as one HTML string (see :func:`write_study_report`)."""
     import matplotlib
 
@@ -372,7 +361,7 @@ def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = 
     )
 
     sec += [s for s in (reduction_section(summary, 7), risk_section(summary, 8),
-                        warehouse_section(summary, 9)) if s]
+                        warehouse_section(summary, 9, plans)) if s]
     line = (f"{summary.get('runs_total')} runs, {summary.get('runs_ok')} ok, "
             f"{summary.get('runs_failed')} failed.")
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
@@ -384,19 +373,22 @@ def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = 
 
 def write_study_report(path: str | os.PathLike[str], summary: dict[str, Any], *,
                        out_dir: str | os.PathLike[str] | None = None, boots: Any = None,
-                       seed: int | None = None, force: bool = False) -> Path:
+                       seed: int | None = None, force: bool = False,
+                       plans: list[Any] = ()) -> Path:
     """Write the HTML report of a study summary.
 
     summary: the dict of ``summary.json`` (JSON values: None for non-finite); out_dir: the
     study folder holding ``study.json`` (default ``summary["out_dir"]``); boots: the list that
     ``summarize(..., boots=[])`` filled (bootstrap samples for the bands; no band without it);
-    seed: the bootstrap seed (shown). Raises InputError if ``path`` exists (without ``force``)
+    seed: the bootstrap seed (shown); plans: a warehouse study's plan figures, one matplotlib
+    Axes per intensity level (``seisrack.studies.warehouse_summary.plan_axes``). Raises
+    InputError if ``path`` exists (without ``force``)
     or cannot be written.
     """
     from seisrack.report.html import check_report_path, write_atomically
 
     p = check_report_path(path, force)
     study = read_study_json(out_dir if out_dir is not None else summary.get("out_dir", "."))
-    text = build_study_html(summary, study=study, boots=boots, seed=seed,
+    text = build_study_html(summary, study=study, boots=boots, seed=seed, plans=plans,
                             date=_dt.datetime.now().isoformat(timespec="seconds"))
     return write_atomically(p, text)

@@ -146,3 +146,18 @@ def generic_tables(summary: dict[str, Any], known: set[str]) -> list[str]:
                 out.append(_table_rows(f"table-{key}", ["quantity", "value"], rows,
                                        f"{key} (from summary.json)"))
     return out
+
+
+def path_cell(path: list[Any], value: Any, factor: float = 1.0, fmt: str = "{:.4g}") -> str:
+    """A number cell with ``data-path`` (its place in summary.json) and ``data-value``."""
+    dp = f'data-path="{esc(json.dumps(path))}"'
+    if value is None:
+        return f'<td class="num" {dp} data-key="{esc(path[-1])}" data-value="null">–</td>'
+    return num_cell(value, factor, fmt, str(path[-1])).replace("<td ", f"<td {dp} ", 1)
+
+
+def table(tid: str, headers: list[str], rows: list[str], caption: str) -> str:
+    """A table with an id, a caption and a header row around prepared ``<tr>`` rows."""
+    head = "".join(f"<th>{esc(h)}</th>" for h in headers)
+    return (f'<table id="{esc(tid)}"><caption>{esc(caption)}</caption><thead><tr>{head}</tr>'
+            f"</thead><tbody>{''.join(rows)}</tbody></table>")
