@@ -63,7 +63,7 @@ def storey_shear_history(model: Any, U: np.ndarray, direction: int = 0) -> np.nd
     """(n_t, n_storey) [N] storey shear along ``direction``: the elastic forces K u on the DOFs
     of that direction above the bottom of each storey, i.e. the net horizontal force that the
     members and bars crossing the storey carry (the uprights' shears on a plane frame, with the
-    bracing on a space frame; :func:`seisrack.design.operators.storey_operators`).
+    bracing on a space frame; :func:`seisrack.fe.storeys.storey_operators`).
 
     U: (n_t, n_dof) [m, rad] displacements relative to the ground.
     """
@@ -74,7 +74,7 @@ def storey_shear_history(model: Any, U: np.ndarray, direction: int = 0) -> np.nd
 def storey_shear_operator(model: Any, direction: int = 0) -> Any:
     """(n_dof, n_storey) sparse map from displacements to the storey shears along
     ``direction`` (see :func:`storey_shear_history`)."""
-    from seisrack.design.operators import storey_operators
+    from seisrack.fe.storeys import storey_operators
 
     name = model.directions[direction]
     return next(o.op for o in storey_operators(model, name)
