@@ -76,9 +76,11 @@ class DesignOps:
 
 def rack_operators(model, phi: np.ndarray, design: bool = True) -> RackOperators:  # noqa: ANN001
     """Project the level-averaging and force-recovery operators of ``model`` onto ``phi``."""
+    from seisrack.fe.recovery import rack_operators as element_operators
     from seisrack.fe.recovery import recovery_operators
 
-    ops = recovery_operators(model)
+    # one pass over the members for both operator sets
+    ops, des = element_operators(model) if design else (recovery_operators(model), None)
     level = tuple(np.column_stack([phi[np.asarray(d)].mean(axis=0) for d in dofs])
                   for dofs in model.level_dofs)
 
@@ -90,7 +92,7 @@ def rack_operators(model, phi: np.ndarray, design: bool = True) -> RackOperators
         base_moment=tuple(proj(o) for o in ops.base_moment),
         below=tuple(proj(o) for o in ops.below), above=tuple(proj(o) for o in ops.above),
         a1=float(model.damping_coefficients[1]), n_upright=ops.n_upright, n_level=ops.n_level,
-        design=design_ops(model, phi, ops, level) if design else None,
+        design=design_ops(model, phi, ops, level, des) if design else None,
     )
 
 
@@ -103,13 +105,11 @@ def _sections(base, below, n_up: int, n_lev: int):  # noqa: ANN001, ANN202
     return out.reshape(*lead, n_up * (n_lev + 1))
 
 
-def design_ops(model, phi: np.ndarray, rec, level: tuple) -> DesignOps:  # noqa: ANN001
-    """:class:`DesignOps` of ``model`` in the basis ``phi`` (and the gravity state)."""
+def design_ops(model, phi: np.ndarray, rec, level: tuple, d) -> DesignOps:  # noqa: ANN001
+    """:class:`DesignOps` of ``model`` in the basis ``phi`` (and the gravity state), from its
+    :func:`~seisrack.fe.recovery.design_operators` ``d``."""
     import scipy.sparse.linalg as sla
 
-    from seisrack.fe.recovery import design_operators
-
-    d = design_operators(model)
     n_up, n_lev = rec.n_upright, rec.n_level
     y0 = float(np.mean(model.nodes[np.asarray(model.base_nodes), 1]))
     height = np.diff(np.r_[y0, np.asarray(model.level_y, dtype=float)])

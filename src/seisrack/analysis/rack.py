@@ -36,39 +36,14 @@ from seisrack.dynamics.engine import single_blas_thread
 from seisrack.errors import InputError, SolverError
 from seisrack.model.features import require
 from seisrack.model.frame_model import FrameModel
-from seisrack.motion.components import GroundMotion, combine
+from seisrack.motion.components import (  # noqa: F401  (DEFAULT_MAX_DT re-exported)
+    DEFAULT_MAX_DT,
+    GroundMotion,
+    analysis_grid,
+    combine,
+    resample,
+)
 from seisrack.motion.records import Record
-
-#: default upper bound of the analysis time step [s]
-DEFAULT_MAX_DT = 0.005
-
-
-def analysis_grid(record: Record | GroundMotion, dt: float | None,
-                  max_dt: float = DEFAULT_MAX_DT) -> int:
-    """Number of analysis steps per record step (the analysis dt is ``record.dt / k``)."""
-    if dt is None:
-        return max(1, math.ceil(record.dt / max_dt - 1e-9))
-    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
-        raise InputError("dt", dt, "a finite time step > 0 s")
-    ratio = record.dt / dt
-    k = round(ratio)
-    if k < 1 or abs(ratio - k) > 1e-6 * max(ratio, 1.0):
-        raise InputError(
-            "dt", dt,
-            f"the record's time step {record.dt:g} s divided by a whole number "
-            f"(e.g. {record.dt:g}, {record.dt / 2:g}, {record.dt / 4:g} s)",
-        )
-    return int(k)
-
-
-def resample(a: np.ndarray, k: int) -> np.ndarray:
-    """Linear interpolation of a record onto ``k`` sub-steps per record step (exact for the
-    piecewise-linear excitation the engine assumes)."""
-    if k == 1:
-        return np.asarray(a, dtype=float)
-    n = a.size
-    x = np.arange((n - 1) * k + 1) / k
-    return np.interp(x, np.arange(n), a)
 
 
 def ground_motion(model: FrameModel, motion: Record | GroundMotion,
@@ -152,11 +127,7 @@ def run_rack(
     k = analysis_grid(mot, dt)
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))
-    nd = model.n_dir
-    ag = np.zeros(((mot.n - 1) * k + 1, nd))
-    for d, a in enumerate(mot.horizontal):
-        ag[:, d] = resample(a, k)
-    av = None if mot.v is None else resample(mot.v, k)
+    ag, av = mot.on_grid(k, model.n_dir)
     if prepared is None:
         prepared = prepare_run(model, basis=basis, vertical=av is not None)
     elif prepared.n_dof != model.n_dof:
@@ -221,7 +192,7 @@ def run_rack(
         rigid_peak = rig.result()["beam_acceleration_magnitude"]
     resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
-    squeeze = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
+    squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
                    beam_acceleration_filtered=None if acc_filt is None
                    else squeeze(acc_filt[idx]),

@@ -8,7 +8,10 @@ DOFs ``mesh.element_dofs`` (node i's slots, then node j's).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from seisrack.fe import elements as e2
 from seisrack.fe import elements3d as e3
@@ -55,3 +58,36 @@ def truss_matrices(mesh: Any) -> tuple[FloatArray, FloatArray]:
     X = mesh.nodes
     return e3.truss_matrices_3d(X[mesh.trusses[:, 0]], X[mesh.trusses[:, 1]], E=mesh.truss_E,
                                 A=mesh.truss_A, rho=mesh.truss_density)
+
+
+@dataclass(frozen=True)
+class EndForceMaps:
+    """What force recovery needs of every member, computed in one pass per dimension.
+
+    T: (n_el, 2·ndf, 2·ndf) transformation, u_local = T u_global; kt: (n_el, 2·ndf, 2·ndf)
+    ``k_local · T``, local end forces from global end displacements; bars: (n_tr, 2·ndm,
+    2·ndm) global stiffness of the pin-ended bars (none in a plane rack).
+    """
+
+    T: FloatArray
+    kt: FloatArray
+    bars: FloatArray
+
+
+def end_force_maps(mesh: Any) -> EndForceMaps:
+    """:class:`EndForceMaps` of ``mesh`` (the plane or the space beam-column, by ``mesh.ndm``)."""
+    L = mesh.lengths
+    if mesh.ndm == 2:
+        c, s = mesh.direction_cosines
+        T = e2.rotation(c, s)
+        k = e2.local_stiffness(mesh.E, mesh.A, mesh.I, L)
+        bars = np.zeros((0, 4, 4))
+    else:
+        X = mesh.nodes
+        T = e3.transformation_3d(e3.local_axes(X[mesh.elements[:, 0]],
+                                               X[mesh.elements[:, 1]], mesh.vecxz))
+        k = e3.local_stiffness_3d(mesh.E, mesh.G, mesh.A, mesh.Iy, mesh.I, mesh.J, L)
+        bars = e3.truss_matrices_3d(X[mesh.trusses[:, 0]], X[mesh.trusses[:, 1]],
+                                    E=mesh.truss_E, A=mesh.truss_A,
+                                    rho=mesh.truss_density)[0]
+    return EndForceMaps(T=T, kt=np.einsum("eij,ejk->eik", k, T), bars=bars)

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from seisrack.fe.frame_elements import local_frames, local_stiffness, truss_matrices
+from seisrack.fe.frame_elements import EndForceMaps, end_force_maps
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
 
 #: local end-force components per mesh dimension: axial (i, j), and per bending plane
@@ -51,11 +51,6 @@ def _as_2d(U: FloatArray) -> tuple[FloatArray, bool]:
     return (U[None, :], True) if U.ndim == 1 else (U, False)
 
 
-def _kt(mesh: FrameMesh) -> FloatArray:
-    """(n_el, 2·ndf, 2·ndf) k_local · T: local end forces from global end displacements."""
-    return np.einsum("eij,ejk->eik", local_stiffness(mesh), local_frames(mesh))
-
-
 def element_end_forces(model: Any, U: FloatArray) -> FloatArray:
     """Local end forces of every beam-column.
 
@@ -71,7 +66,7 @@ def element_end_forces(model: Any, U: FloatArray) -> FloatArray:
     # Append a zero column so restrained DOFs (-1) read 0.
     padded = np.concatenate([U2, np.zeros((U2.shape[0], 1))], axis=1)
     ue = padded[:, mesh.element_dofs]  # (n_t, n_el, 2 ndf), -1 -> last column
-    f = np.einsum("eik,tek->tei", _kt(mesh), ue)
+    f = np.einsum("eik,tek->tei", end_force_maps(mesh).kt, ue)
     return f[0] if squeeze else f
 
 
@@ -81,15 +76,15 @@ def nodal_element_forces(model: Any, U: FloatArray) -> FloatArray:
     mesh = _mesh(model)
     U2, _ = _as_2d(U)
     nf = mesh.ndf
-    T = local_frames(mesh)
-    fg = np.einsum("eji,tej->tei", T, element_end_forces(mesh, U2))
+    maps = end_force_maps(mesh)
+    padded = np.concatenate([U2, np.zeros((U2.shape[0], 1))], axis=1)
+    f = np.einsum("eik,tek->tei", maps.kt, padded[:, mesh.element_dofs])
+    fg = np.einsum("eji,tej->tei", maps.T, f)
     out = np.zeros((U2.shape[0], mesh.nodes.shape[0], nf))
     np.add.at(out, (slice(None), mesh.elements[:, 0]), fg[:, :, :nf])
     np.add.at(out, (slice(None), mesh.elements[:, 1]), fg[:, :, nf:])
     if mesh.trusses.shape[0]:
-        kt, _ = truss_matrices(mesh)
-        padded = np.concatenate([U2, np.zeros((U2.shape[0], 1))], axis=1)
-        ft = np.einsum("eik,tek->tei", kt, padded[:, mesh.truss_dofs])
+        ft = np.einsum("eik,tek->tei", maps.bars, padded[:, mesh.truss_dofs])
         nd = mesh.ndm
         np.add.at(out, (slice(None), mesh.trusses[:, 0], slice(0, nd)), ft[:, :, :nd])
         np.add.at(out, (slice(None), mesh.trusses[:, 1], slice(0, nd)), ft[:, :, nd:])
@@ -198,16 +193,22 @@ class RecoveryOperators:
                               above=np.asarray(U2 @ self.above[direction]).reshape(shape))
 
 
-def recovery_operators(model: Any) -> RecoveryOperators:
-    """Build the :class:`RecoveryOperators` of a compiled rack from its element stiffness rows."""
+def rack_operators(model: Any) -> tuple[RecoveryOperators, DesignOperators]:
+    """Both operator sets of a compiled rack from one pass over its members."""
+    maps = end_force_maps(_mesh(model))
+    return recovery_operators(model, maps), design_operators(model, maps)
+
+
+def recovery_operators(model: Any, maps: EndForceMaps | None = None) -> RecoveryOperators:
+    """Build the :class:`RecoveryOperators` of a compiled rack from its element stiffness rows
+    (``maps``: its :func:`~seisrack.fe.frame_elements.end_force_maps`, computed if not given)."""
     mesh = _mesh(model)
     n, nf, ndm = mesh.n_dof, mesh.ndf, mesh.ndm
     n_dir = len(_SLOT[ndm])
     edofs = mesh.element_dofs
-    kt = _kt(mesh)
-    kg = np.einsum("eji,ejk->eik", local_frames(mesh), kt)  # Tᵀ k T: global end forces
-    if mesh.trusses.shape[0]:
-        ktr, _ = truss_matrices(mesh)
+    maps = end_force_maps(mesh) if maps is None else maps
+    kt, ktr = maps.kt, maps.bars
+    kg = np.einsum("eji,ejk->eik", maps.T, kt)  # Tᵀ k T: global end forces
 
     # Base shear along d: -Σ of the reactions along d. A restrained translation reacts with the
     # sum of the global end forces of the members and bars meeting there; a free one with its
@@ -326,12 +327,13 @@ def column_labels(model: Any) -> tuple[str, ...]:
                  for ln, s in zip(model.column_line, model.column_side, strict=True))
 
 
-def design_operators(model: Any) -> DesignOperators:
-    """Build the :class:`DesignOperators` of a compiled rack (beam ends, connectors, upright N)."""
+def design_operators(model: Any, maps: EndForceMaps | None = None) -> DesignOperators:
+    """Build the :class:`DesignOperators` of a compiled rack (beam ends, connectors, upright N;
+    ``maps`` as for :func:`recovery_operators`)."""
     mesh = _mesh(model)
     n, ndm, nf = mesh.n_dof, mesh.ndm, mesh.ndf
     edofs = mesh.element_dofs
-    kt = _kt(mesh)
+    kt = (end_force_maps(mesh) if maps is None else maps).kt
     kind = np.asarray(model.element_kind)
     storey = np.asarray(model.element_storey)
     line = np.asarray(model.element_line)

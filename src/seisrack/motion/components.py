@@ -21,6 +21,8 @@ from seisrack.motion.records import Record
 
 #: relative tolerance on equal time steps of the components
 _DT_RTOL = 1e-9
+#: default upper bound of the analysis time step [s]
+DEFAULT_MAX_DT = 0.005
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,6 +79,15 @@ class GroundMotion:
         return GroundMotion(pad(self.x), pad(self.z), pad(self.v), self.dt, self.names,
                             self.angle_deg)
 
+    def on_grid(self, k: int, n_dir: int) -> tuple[np.ndarray, np.ndarray | None]:
+        """The horizontal components as ``(n_steps + 1, n_dir)`` (a structure with two
+        horizontal directions under a motion with one: zero cross-aisle) and the vertical one
+        (or None), on ``k`` analysis steps per record step (:func:`resample`)."""
+        ag = np.zeros(((self.n - 1) * k + 1, n_dir))
+        for d, a in enumerate(self.horizontal):
+            ag[:, d] = resample(a, k)
+        return ag, None if self.v is None else resample(self.v, k)
+
     def scaled(self, factor: float) -> GroundMotion:
         """Every component (the vertical one too) multiplied by ``factor``."""
 
@@ -129,3 +140,31 @@ def combine(down: Record | None, cross: Record | None = None, vertical: Record |
     names = (down.name if down is not None else "", cross.name if cross is not None else "",
              vertical.name if vertical is not None else "")
     return GroundMotion(x, z, v, ref.dt, names, float(angle_deg))
+
+
+def analysis_grid(record: Record | GroundMotion, dt: float | None,
+                  max_dt: float = DEFAULT_MAX_DT) -> int:
+    """Number of analysis steps per record step (the analysis dt is ``record.dt / k``)."""
+    if dt is None:
+        return max(1, math.ceil(record.dt / max_dt - 1e-9))
+    if not (isinstance(dt, int | float) and math.isfinite(dt) and dt > 0):
+        raise InputError("dt", dt, "a finite time step > 0 s")
+    ratio = record.dt / dt
+    k = round(ratio)
+    if k < 1 or abs(ratio - k) > 1e-6 * max(ratio, 1.0):
+        raise InputError(
+            "dt", dt,
+            f"the record's time step {record.dt:g} s divided by a whole number "
+            f"(e.g. {record.dt:g}, {record.dt / 2:g}, {record.dt / 4:g} s)",
+        )
+    return int(k)
+
+
+def resample(a: np.ndarray, k: int) -> np.ndarray:
+    """Linear interpolation of a record onto ``k`` sub-steps per record step (exact for the
+    piecewise-linear excitation the engine assumes)."""
+    if k == 1:
+        return np.asarray(a, dtype=float)
+    n = a.size
+    x = np.arange((n - 1) * k + 1) / k
+    return np.interp(x, np.arange(n), a)
