@@ -99,7 +99,7 @@ def test_summary_reduction_statistics(study) -> None:  # noqa: ANN001
 
 
 def test_summary_text_and_json_cli(study, capsys) -> None:  # noqa: ANN001
-    from seisrack.studies.summary import summary_main
+    from test_study_summary import summary_main
 
     _, out, _ = study
     assert summary_main([str(out), "--boot", "0", "--no-plots"]) == 0
@@ -126,7 +126,7 @@ def test_old_store_without_rigid_columns(study, tmp_path) -> None:  # noqa: ANN0
 
 def test_study_report_reduction_section(study, tmp_path) -> None:  # noqa: ANN001
     pytest.importorskip("matplotlib")
-    from seisrack.studies.summary import summary_main
+    from test_study_summary import summary_main
 
     _, out, _ = study
     html = tmp_path / "s.html"

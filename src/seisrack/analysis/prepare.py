@@ -44,6 +44,9 @@ class PreparedRun:
     vertical: bool
     n_dof: int
 
+    def __post_init__(self) -> None:
+        _locked(self)  # shared by every run of the model
+
 
 def rack_sliders(model: FrameModel, mu: float | None = None) -> Sliders | PlanarSliders:
     """The pallets of ``model`` as the engine's sliders: along a line when the rack has one
@@ -59,40 +62,34 @@ def rack_sliders(model: FrameModel, mu: float | None = None) -> Sliders | Planar
     return PlanarSliders(d[:, :, 0], d[:, :, 1], model.pallet_mass, mus, mud)
 
 
-def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: bool = False,
-                design: bool = True) -> PreparedRun:
-    """The :class:`PreparedRun` of ``model`` (cached per model for a named basis: a compiled
-    model is immutable, so the cache cannot go stale)."""
-    if isinstance(basis, Basis):
-        return _prepare(model, basis, vertical, design)
-    if basis not in ("auto", "full", "reduced"):
-        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    cache = _model_cache(model)
-    key = (basis, bool(vertical), bool(design))
-    hit = cache.get(key)
-    if hit is None:
-        hit = cache[key] = _prepare(model, basis, vertical, design)
-    return hit
-
-
-def _prepare(model: FrameModel, basis: str | Basis, vertical: bool, design: bool
-             ) -> PreparedRun:
-    hinges = rack_hinges(model)
-    bas = choose_basis(basis, model.M_sparse, model.K_sparse, rack_sliders(model),
-                       model.influence, rv=model.r_y if vertical else None, hinges=hinges)
-    return _locked(PreparedRun(basis=bas, ops=rack_operators(model, bas.phi, design=design),
-                               hinges=hinges, vertical=vertical, n_dof=model.n_dof))
-
-
 #: per compiled model (weakly held: dropped with the model), its prepared runs
 _MODEL_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
-def _model_cache(model: FrameModel) -> dict:
-    try:
-        return _MODEL_CACHE.setdefault(model, {})
-    except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
-        return {}
+def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: bool = False,
+                design: bool = True) -> PreparedRun:
+    """The :class:`PreparedRun` of ``model`` (cached per model for a named basis: a compiled
+    model is immutable, so the cache cannot go stale)."""
+    given = isinstance(basis, Basis)
+    if not given and basis not in ("auto", "full", "reduced"):
+        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    cache: dict = {}
+    if not given:
+        try:
+            cache = _MODEL_CACHE.setdefault(model, {})
+        except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
+            pass
+    key = (None if given else basis, bool(vertical), bool(design))
+    hit = cache.get(key)
+    if hit is None:
+        sliders = rack_sliders(model)
+        hinges = rack_hinges(model)
+        bas = choose_basis(basis, model.M_sparse, model.K_sparse, sliders, model.influence,
+                           rv=model.r_y if vertical else None, hinges=hinges)
+        ops = rack_operators(model, bas.phi, design=design)
+        hit = cache[key] = PreparedRun(basis=bas, ops=ops, hinges=hinges, vertical=vertical,
+                                       n_dof=model.n_dof)
+    return hit
 
 
 def _locked(obj):  # noqa: ANN001, ANN202

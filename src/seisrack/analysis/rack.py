@@ -13,7 +13,6 @@ down-aisle impacts. Peaks are taken over every step, whatever ``save_every`` kee
 
 from __future__ import annotations
 
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import replace
@@ -22,7 +21,13 @@ import numpy as np
 
 from seisrack.analysis.hinges import HingePeaks, hinge_response
 from seisrack.analysis.pallet_contacts import ContactTracker
-from seisrack.analysis.peaks import PeakTracker, connection_moment, level_sum, with_direction
+from seisrack.analysis.peaks import (  # noqa: F401  (lowpass re-exported)
+    PeakTracker,
+    connection_moment,
+    level_sum,
+    lowpass,
+    with_direction,
+)
 from seisrack.analysis.prepare import RIGID_MU, PreparedRun, prepare_run, rack_sliders
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
@@ -124,6 +129,8 @@ def run_rack(
             and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
     mot = ground_motion(model, motion, vertical)
+    if method == "exact":
+        require("exact modal propagators (method exact)", model.ndm, "method", method)
     k = analysis_grid(mot, dt)
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))
@@ -135,6 +142,7 @@ def run_rack(
                          f"prepare_run(model) of this model ({model.n_dof} DOFs)")
     ops, bas, hinges = prepared.ops, prepared.basis, prepared.hinges
     sliders = rack_sliders(model)
+    held = rack_sliders(model, RIGID_MU) if rigid_companion and model.n_pallets else None
     infl = np.column_stack(model.influence)
     common = dict(dt=h, ground_accel=ag, influence=infl, vertical_accel=av,
                   vertical_influence=None if av is None else model.r_y, g=model.g,
@@ -142,8 +150,6 @@ def run_rack(
     line = isinstance(sliders, Sliders)
     if line:
         common["method"] = method
-    elif method == "exact":
-        require("exact modal propagators (method exact)", model.ndm, "method", method)
     # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
     # engine takes Newmark for sliders in the plane, for a rack on a line exactly when asked
     # or when the damping has a mass term
@@ -182,12 +188,12 @@ def run_rack(
     peaks["beam_acceleration_filtered"] = (
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
     rigid_peak = None
-    if rigid_companion and model.n_pallets:
+    if held is not None:
         rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False)
         if line:
             common["method"] = "exact" if hist.method == "exact" else method
-        simulate(model.M_sparse, model.C_sparse, model.K_sparse, rack_sliders(model, RIGID_MU),
-                 **common, save_every=None, on_chunk=rig, track_energy=False,
+        simulate(model.M_sparse, model.C_sparse, model.K_sparse, held, **common,
+                 save_every=None, on_chunk=rig, track_energy=False,
                  **({"hinges": hinges} if line else {}))
         rigid_peak = rig.result()["beam_acceleration_magnitude"]
     resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
@@ -197,32 +203,6 @@ def run_rack(
                    beam_acceleration_filtered=None if acc_filt is None
                    else squeeze(acc_filt[idx]),
                    hinges=None if hinges is None else hinge_response(model, hist, hpk))
-
-
-def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
-    """Zero-phase Butterworth low-pass of ``a: (n_t, ...)`` sampled every ``h`` [s] at ``fc``
-    [Hz], along the first axis.
-
-    ``scipy.signal.sosfiltfilt`` (forward and backward: no phase shift, so peaks stay at their
-    time; the magnitude response is the square of the order-``order`` filter's, -6 dB at fc).
-    A cut-off at or above the Nyquist frequency returns ``a`` unchanged.
-    """
-    from scipy.signal import sosfiltfilt
-
-    a = np.asarray(a, dtype=float)
-    if fc >= 0.5 / h or a.shape[0] < 2:
-        return a.copy()
-    sos = _butter_sos(int(order), float(fc), float(h)).copy()  # scipy wants it writable
-    pad = min(3 * (2 * sos.shape[0] + 1), a.shape[0] - 1)
-    return sosfiltfilt(sos, a, axis=0, padlen=pad)
-
-
-@functools.lru_cache(maxsize=32)
-def _butter_sos(order: int, fc: float, h: float) -> np.ndarray:
-    """Butterworth second-order sections (designed once per (order, fc, h): ~1 ms each)."""
-    from scipy.signal import butter
-
-    return butter(order, fc, btype="low", fs=1.0 / h, output="sos")
 
 
 def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
