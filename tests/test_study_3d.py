@@ -180,12 +180,14 @@ def test_a_row_equals_a_direct_run(stored) -> None:
     motion = combine(a, b, angle_deg=45.0)
     resp = run_rack(model, motion.scaled(f), save_every=None, dt=0.005)
     by_dir = resp.pallet_peak_sliding_by_direction().max(axis=0)
-    assert row["peak_sliding_down_aisle_max_m"] == pytest.approx(by_dir[0], rel=1e-9)
-    assert row["peak_sliding_cross_aisle_max_m"] == pytest.approx(by_dir[1], rel=1e-9)
+    # rel 1e-7: the study ran in another process (its BLAS may sum in another order: 1.3e-9
+    # was seen once in a loaded full suite)
+    assert row["peak_sliding_down_aisle_max_m"] == pytest.approx(by_dir[0], rel=1e-7)
+    assert row["peak_sliding_cross_aisle_max_m"] == pytest.approx(by_dir[1], rel=1e-7)
     assert row["n_aisle_fall"] == len(resp.falls)
     assert row["any_aisle_fall"] == bool(resp.falls)
     assert row["peak_sliding_max_m"] == pytest.approx(resp.pallet_peak_sliding().max(),
-                                                      rel=1e-9)
+                                                      rel=1e-7)
 
 
 def test_dask_gives_the_same_table(stored, tmp_path: Path) -> None:
