@@ -1,0 +1,83 @@
+"""The local engine's inputs from a compiled rack (2D :class:`~seisrack.model.frame_model.
+FrameModel` or 3D :class:`~seisrack.model.frame_model3d.FrameModel3D`): the slice of every
+DOF (the upright line and the bay to its right, from the node's x), the pallets as
+:class:`LocalSliders`, and the global loads whose responses carry the far field (a uniform
+load on every beam level, per side and direction)."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from seisrack.dynamics.local.sliders import LocalSliders
+
+
+def _node_x(model) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
+    """(n,) x of each DOF's node (a DOF shared by nodes takes the largest x; a DOF of no
+    node, e.g. a spring's own rotation, that of a DOF it is coupled to) and the nodes' DOF
+    table."""
+    nodes = np.asarray(model.mesh.nodes)
+    nd = np.asarray(model.mesh.node_dofs)
+    x = np.full(model.K_sparse.shape[0], -np.inf)
+    for c in range(nd.shape[1]):
+        on = nd[:, c] >= 0
+        np.maximum.at(x, nd[on, c], nodes[on, 0])
+    lost = np.flatnonzero(~np.isfinite(x))
+    if lost.size:
+        K = sp.csr_matrix(model.K_sparse)
+        for d in lost:
+            cols = K.indices[K.indptr[d]:K.indptr[d + 1]]
+            xs = x[cols][np.isfinite(x[cols])]
+            x[d] = xs.max() if xs.size else 0.0
+    return x, nd
+
+
+def rack_slices(model) -> np.ndarray:  # noqa: ANN001
+    """(n,) slice of every DOF: slice s holds the upright line s and the bay to its right
+    (the last upright line joins the last bay)."""
+    from seisrack.dynamics.local.basis import slices_by_coordinate
+
+    x, _ = _node_x(model)
+    ux = np.asarray(model.upright_x, dtype=float)
+    cuts = ux[:-1] if ux.size > 1 else ux
+    return slices_by_coordinate(x, cuts)
+
+
+def rack_sliders(model) -> LocalSliders:  # noqa: ANN001
+    """The pallets of ``model``: 3D, resting on the front and rear beam nodes, sliding in x
+    and z; 2D, on one DOF, sliding along x."""
+    if getattr(model, "is_3d", False):
+        sup = np.stack([model.pallet_dof_x, model.pallet_dof_z], axis=2)
+    else:
+        sup = np.asarray(model.pallet_dof)[:, None, None]
+    return LocalSliders(sup, model.pallet_mass, model.pallet_mu_static,
+                        model.pallet_mu_dynamic)
+
+
+def rack_global_loads(model, mass: sp.spmatrix) -> np.ndarray:  # noqa: ANN001
+    """(n, g) a uniform load on every beam level (3D: per side, x and z; 2D: x), weighted by
+    ``mass``: their static responses carry the sway of the whole row into every patch."""
+    x, nd = _node_x(model)
+    nodes = np.asarray(model.mesh.nodes)
+    ys = np.asarray(model.level_y)
+    n = model.K_sparse.shape[0]
+    cols = []
+    if getattr(model, "is_3d", False):
+        zs = (0.0, float(model.depth))
+        comps = (0, 2)
+    else:
+        zs = (None,)
+        comps = (0,)
+    for y in ys:
+        on_level = np.abs(nodes[:, 1] - y) < 1e-6
+        for z in zs:
+            sel = on_level if z is None else on_level & (np.abs(nodes[:, 2] - z) < 1e-6)
+            for c in comps:
+                d = np.unique(nd[sel, c])
+                d = d[d >= 0]
+                if d.size == 0:
+                    continue
+                e = np.zeros(n)
+                e[d] = 1.0
+                cols.append(mass @ e)
+    return np.column_stack(cols) if cols else np.zeros((n, 0))
