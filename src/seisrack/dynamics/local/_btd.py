@@ -11,34 +11,14 @@ blocks) and ``X`` with ``X[s] = L_ss⁻¹ A_(s, s+1)`` (= ``L_(s+1, s)ᵀ``), so
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
 
-import numpy as np
 
-try:  # injected by the loader; identity when this file is imported directly
-    _JIT  # type: ignore[used-before-def]  # noqa: B018
-except NameError:  # pragma: no cover
+try:  # names injected by the loader when executed after ``_blas.py``
+    _potrf_corner  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics.local._blas import _potrf_corner, _syrk_corner, _trsm_corner
 
     def _JIT(f):  # type: ignore[no-redef]
         return f
-
-
-@_JIT
-def _chol_block(A, b):
-    """In-place lower Cholesky factor of A[:b, :b] (lower triangle read and written); False
-    if not positive definite."""
-    for j in range(b):
-        d = A[j, j]
-        for k in range(j):
-            d -= A[j, k] * A[j, k]
-        if not (d > 0.0 and np.isfinite(d)):
-            return False
-        d = np.sqrt(d)
-        A[j, j] = d
-        for i in range(j + 1, b):
-            acc = A[i, j]
-            for k in range(j):
-                acc -= A[i, k] * A[j, k]
-            A[i, j] = acc / d
-    return True
 
 
 @_JIT
@@ -63,8 +43,8 @@ def _trsv_upper(L, b, x):
 
 @_JIT
 def _btd_factor(Hd, Ho, sizes, Ld, X):
-    """Cholesky factor of the block-tridiagonal (Hd, Ho) into (Ld, X). False if the matrix
-    is not positive definite."""
+    """Cholesky factor of the block-tridiagonal (Hd, Ho) into (Ld, X) (LAPACK / BLAS on the
+    blocks, ``_blas.py``). False if the matrix is not positive definite."""
     ns = sizes.shape[0]
     for s in range(ns):
         b = sizes[s]
@@ -73,27 +53,18 @@ def _btd_factor(Hd, Ho, sizes, Ld, X):
             for k in range(i + 1):
                 L[i, k] = Hd[s, i, k]
         if s > 0:
-            bp = sizes[s - 1]
-            Xp = X[s - 1]
             # S = H_ss − Xᵀ X (lower triangle)
-            for i in range(b):
-                for k in range(i + 1):
-                    acc = 0.0
-                    for r in range(bp):
-                        acc += Xp[r, i] * Xp[r, k]
-                    L[i, k] -= acc
-        if not _chol_block(L, b):
+            _syrk_corner(L, b, X[s - 1], sizes[s - 1])
+        if not _potrf_corner(L, b):
             return False
         if s + 1 < ns:
             bn = sizes[s + 1]
             Xs = X[s]
-            # X_s = L⁻¹ H_(s, s+1), column by column (forward substitution on rows)
             for i in range(b):
                 for c in range(bn):
-                    acc = Ho[s, i, c]
-                    for k in range(i):
-                        acc -= L[i, k] * Xs[k, c]
-                    Xs[i, c] = acc / L[i, i]
+                    Xs[i, c] = Ho[s, i, c]
+            # X_s = L⁻¹ H_(s, s+1)
+            _trsm_corner(L, b, Xs, bn)
     return True
 
 

@@ -31,6 +31,9 @@ STATUS_NOT_PD = 4
 _NEWTON_MAX = 40
 #: fields of a pallet's local solution (``_pallet_solve``'s ``out``)
 _NOUT = 19
+DEBUG = False
+WARM = True
+DEBUG_STEP = -1
 
 
 @_JIT
@@ -39,6 +42,33 @@ def _support(P, p, s0, b, x, d):
     for i in range(b):
         acc += P[p, d, i] * x[s0 + i]
     return acc
+
+
+@_JIT
+def _psd_row(D, p, mp):
+    """Row p of D (m, 4), a 2 × 2 ∂J/∂y, symmetrised with its eigenvalues clipped to [0, m]
+    (the pallet's own mass bounds a monotone part; a start-of-step matrix needs no more)."""
+    a = D[p, 0]
+    b = 0.5 * (D[p, 1] + D[p, 2])
+    c = D[p, 3]
+    tr = 0.5 * (a + c)
+    dif = 0.5 * (a - c)
+    rad = np.sqrt(dif * dif + b * b)
+    l1 = min(max(tr + rad, 0.0), mp)
+    l2 = min(max(tr - rad, 0.0), mp)
+    if rad == 0.0:
+        D[p, 0] = l1
+        D[p, 1] = 0.0
+        D[p, 2] = 0.0
+        D[p, 3] = l2
+        return
+    ang = 0.5 * np.arctan2(b, dif)
+    cs = np.cos(ang)
+    sn = np.sin(ang)
+    D[p, 0] = l1 * cs * cs + l2 * sn * sn
+    D[p, 1] = (l1 - l2) * cs * sn
+    D[p, 2] = D[p, 1]
+    D[p, 3] = l1 * sn * sn + l2 * cs * cs
 
 
 @_JIT
@@ -107,8 +137,10 @@ def _own_compliance(Ld, P, p, s, b, nd, Dp, t1, t2):
 
 @_JIT
 def _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, agp0, agp1,
-                  stuck, sv, dirn, jerk, Gc, gstamp, stamp, Ld, Dp, outs, ev, t1, t2, stats):
-    """Every pallet's local solution for the structure's velocity change ``dv``."""
+                  stuck, sv, dirn, jerk, Gc, gstamp, stamp, Ld, Dp, outs, ev, t1, t2, stats,
+                  want_D):
+    """Every pallet's local solution for the structure's velocity change ``dv`` (warm
+    started from the β already in its row of ``outs``; ∂J/∂y written when ``want_D``)."""
     m = ps.shape[0]
     for p in range(m):
         s = ps[p]
@@ -121,7 +153,7 @@ def _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, ag
             fast = _pallet_solve(yx, yz, True, 0.0, 0.0, dirn[p, 0], dirn[p, 1], h, mass[p],
                                  mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
                                  agp1[1], jerk[p, 0], jerk[p, 1], 0.0, 0.0, 0.0, nd, ev[p],
-                                 row)
+                                 row, False, want_D)
             if fast:
                 continue
         if gstamp[p] != stamp:
@@ -134,7 +166,7 @@ def _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, ag
         _pallet_solve(yx, yz, stuck[p], sv[p, 0], sv[p, 1], dirn[p, 0], dirn[p, 1], h,
                       mass[p], mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
                       agp1[1], jerk[p, 0], jerk[p, 1], Gc[p, 0], Gc[p, 1], Gc[p, 2], nd,
-                      ev[p], row)
+                      ev[p], row, WARM, want_D)
 
 
 @_JIT
@@ -202,6 +234,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
     t1 = np.empty(bmax)
     t2 = np.empty(bmax)
     Nk0 = np.empty(m)
+    mus_k = np.empty(m)
     Nk1 = np.empty(m)
     n_ev = 0
     status = STATUS_OK
@@ -237,6 +270,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 for i in range(N):
                     fbar[i] += a * pat[c, i]
         for p in range(m):
+            mus_k[p] = mus[p]
             Nk0[p] = max(mass[p] * gz[k], 0.0)
             Nk1[p] = max(mass[p] * gz[k + 1], 0.0)
         # rhs = h f̄ − h C v0 − h K (q0 + h v0 / 2)
@@ -252,6 +286,12 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 Dp[p, 1] = 0.0
                 Dp[p, 2] = 0.0
                 Dp[p, 3] = mass[p] if nd == 2 else 0.0
+            else:
+                _psd_row(Dp, p, mass[p])
+                if nd == 1:
+                    Dp[p, 1] = 0.0
+                    Dp[p, 2] = 0.0
+                    Dp[p, 3] = 0.0
         _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
         stats[2] += 1
         if not _btd_factor(Hd, Ho, sizes, Ld, X):
@@ -261,9 +301,9 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
         # predictor: the last step's Δv
         for i in range(N):
             dv[i] = dvp[i]
-        _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, agp[k],
+        _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
                       agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp, stamp, Ld, Dp, outs, ev,
-                      t1, t2, stats)
+                      t1, t2, stats, False)
         _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
         vscale = 1e-300
         for i in range(N):
@@ -275,17 +315,28 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             stats[1] += 1
             if refac:
                 # a poor contraction: the Newton matrix with the pallets' current ∂J/∂y
-                for p in range(m):
-                    for c in range(4):
-                        Dn[p, c] = outs[p, 2 + c]
-                _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dn, nd)
-                stats[2] += 1
-                if not _btd_factor(Hd, Ho, sizes, Ld2, X2):
-                    # indefinite (finite differences across a kink): keep the last factor
-                    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
-                else:
-                    Ld[:] = Ld2
-                    X[:] = X2
+                # (an onset with mu_d < mu_s makes ∂J/∂y negative, bounded by the support's
+                # own stiffness: H stays positive definite, §4.3; if finite differences across
+                # a kink break that, the clipped ∂J/∂y is used)
+                _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp, stamp,
+                              Ld, Dp, outs, ev, t1, t2, stats, True)
+                for attempt in range(2):
+                    for p in range(m):
+                        for c in range(4):
+                            Dn[p, c] = outs[p, 2 + c]
+                        if attempt == 1:
+                            _psd_row(Dn, p, mass[p])
+                        if nd == 1:
+                            Dn[p, 1] = 0.0
+                            Dn[p, 2] = 0.0
+                            Dn[p, 3] = 0.0
+                    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dn, nd)
+                    stats[2] += 1
+                    if _btd_factor(Hd, Ho, sizes, Ld2, X2):
+                        Ld[:] = Ld2
+                        X[:] = X2
+                        break
                 refac = False
             for i in range(N):
                 dlt[i] = -R[i]
@@ -304,9 +355,9 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             # trial point
             for i in range(N):
                 tmp[i] = dv[i] + dlt[i]
-            _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1,
+            _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
                           agp[k], agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp, stamp, Ld,
-                          Dp, outs_n, ev, t1, t2, stats)
+                          Dp, outs_n, ev, t1, t2, stats, False)
             _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
             g1 = 0.0
             for i in range(N):
@@ -324,9 +375,9 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                     alpha = lo - glo * (hi - lo) / (ghi - glo)
                     for i in range(N):
                         tmp[i] = dv[i] + alpha * dlt[i]
-                    _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0,
+                    _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0,
                                   Nk1, agp[k], agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp,
-                                  stamp, Ld, Dp, outs_n, ev, t1, t2, stats)
+                                  stamp, Ld, Dp, outs_n, ev, t1, t2, stats, False)
                     _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
                     ga = 0.0
                     for i in range(N):
@@ -360,6 +411,30 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             if prev >= 0.0 and alpha * dmax > 0.2 * prev:
                 refac = True
             prev = alpha * dmax
+            if DEBUG and k == DEBUG_STEP:
+                print("it", _it, "dmax", dmax, "alpha", alpha, "g0", g0, "g1", g1)
+                for p in range(m):
+                    print("   p", p, "stuck0", stuck[p], "J", outs[p, 0], outs[p, 1], "D",
+                          outs[p, 2], outs[p, 3], outs[p, 4], outs[p, 5], "end", outs[p, 6],
+                          "nev", outs[p, 17], "mus_k", mus_k[p])
+            if _it >= 6 and _it % 3 == 0:
+                # stalled: a pallet whose impulse jumps with y (a grazing slip onset, where
+                # the holding force touches mu_s N inside the step) has no root; it keeps its
+                # start state's contact for this step (theory §4.3)
+                for i in range(N):
+                    tmp[i] = dv[i] + 1e-6 * dlt[i]
+                _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp, stamp,
+                              Ld, Dp, outs_n, ev, t1, t2, stats, False)
+                for p in range(m):
+                    dj = abs(outs_n[p, 0] - outs[p, 0]) + abs(outs_n[p, 1] - outs[p, 1])
+                    if dj > 1e-4 * (abs(outs[p, 0]) + abs(outs[p, 1]) + mass[p] * h):
+                        mus_k[p] = 1e300
+                        stats[5] += 1
+                _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, Gc, gstamp, stamp,
+                              Ld, Dp, outs, ev, t1, t2, stats, False)
+                _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
         if not converged:
             status = STATUS_NEWTON
             break

@@ -6,6 +6,6 @@ from seisrack.dynamics._numba_build import JIT as _JIT  # noqa: F401  (used by t
 from seisrack.dynamics._numba_build import combined_source
 
 _SRC = combined_source(("_events.py", "_planar_lapack.py", "_planar_step.py",
-                        "_planar_contact.py", "local/_btd.py", "local/_pallet.py",
+                        "_planar_contact.py", "local/_blas.py", "local/_btd.py", "local/_pallet.py",
                         "local/_kernel.py"), "_local")
 exec(compile(_SRC.read_text(encoding="utf-8"), str(_SRC), "exec"))  # noqa: S102

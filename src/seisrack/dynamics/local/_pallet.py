@@ -25,12 +25,10 @@ except NameError:  # pragma: no cover
 
     from seisrack.dynamics._planar_contact import _disc_min
 
-#: local sub-steps of a sliding phase are halved while its direction turns by more than this
-#: (cosine of 5°) and they are longer than _MIN_SUB of the step, at most _MAX_SUB sub-steps a
-#: step
-_COS_TURN = 0.9961946980917455
-_MIN_SUB = 1e-4
-_MAX_SUB = 64
+#: a sliding phase is integrated in this many equal sub-steps of what is left of the step
+#: (a fixed grid: a grid adapted to the turn of the direction made J(y) jump by a few % where
+#: the decision to halve flipped, which stalled the step's Newton iteration)
+_NSUB = 4
 #: phases (stuck or sliding) inside one step beyond which the state is kept to the step's end
 _MAX_PHASES = 16
 #: event kinds as the shared event core (_events.py): slip, stick, reverse (turn)
@@ -218,6 +216,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
     n_ev = 0
     n_ph = 0
     n_sub = 0
+    grid = h / _NSUB
     while t < h:
         if stuck:
             te = h
@@ -231,6 +230,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             if t >= h:
                 break
             n_ph += 1
+            n_sub = 0
             # slip: the force from the disc problem at te
             cx = c0x + c1x * t
             cz = c0z + c1z * t
@@ -249,37 +249,35 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                 ev[n_ev, 1] = _EV_SLIP
             n_ev += 1
             continue
-        # sliding: trapezoidal sub-steps with the return map
-        tb = h
-        stop = False
-        while True:
-            dl = tb - t
-            cax = c0x + c1x * t
-            caz = c0z + c1z * t
-            cbx = c0x + c1x * tb
-            cbz = c0z + c1z * tb
-            zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
-            zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
-            kap = 0.5 * dl * mud * (N0 + n1 * tb)
-            sig, ex, ez, slides = _return_map(zx, zz, kap, w11, w12, w22)
-            if not slides:
-                stop = True
-                break
-            # direction change across the sub-step
-            pnx = sx
-            pnz = sz
-            pn = np.sqrt(pnx * pnx + pnz * pnz)
-            if pn == 0.0:
-                pnx = dx
-                pnz = dz
-                pn = 1.0
-            if (pnx * ex + pnz * ez) / pn >= _COS_TURN or dl <= _MIN_SUB * h \
-                    or n_sub >= _MAX_SUB:
-                break
-            tb = t + 0.5 * dl
+        # sliding: trapezoidal sub-steps with the return map on a fixed grid of the phase
+        if n_sub == 0:
+            grid = (h - t) / _NSUB
         n_sub += 1
+        tb = min(t + grid, h)
+        if h - tb <= 1e-9 * h:
+            tb = h
+        stop = False
+        dl = tb - t
+        cax = c0x + c1x * t
+        caz = c0z + c1z * t
+        cbx = c0x + c1x * tb
+        cbz = c0z + c1z * tb
+        zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
+        zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
+        kap = 0.5 * dl * mud * (N0 + n1 * tb)
+        sig, ex, ez, slides = _return_map(zx, zz, kap, w11, w12, w22)
+        # the direction at the start of the sub-step: a velocity that turns by more than a
+        # right angle inside it passed near zero, where a stop (1D: a reversal) can hide
+        pnx = sx
+        pnz = sz
+        if sx == 0.0 and sz == 0.0:
+            pnx = dx
+            pnz = dz
+        if not slides or pnx * ex + pnz * ez <= 0.0:
+            stop = True
+        turned = False
         if stop and n_ph <= _MAX_PHASES:
-            # locate the stop: f(τ) = |(κW)⁻¹ z(τ)| − 1 changes sign in (t, tb]
+            # locate the first τ where the sub-step to τ stops or turns back
             lo = t
             hi = tb
             for _it in range(60):
@@ -290,8 +288,8 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                 zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
                 zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
                 kap = 0.5 * dl * mud * (N0 + n1 * mid)
-                _s, _ex, _ez, sl2 = _return_map(zx, zz, kap, w11, w12, w22)
-                if sl2:
+                _s, ex2, ez2, sl2 = _return_map(zx, zz, kap, w11, w12, w22)
+                if sl2 and pnx * ex2 + pnz * ez2 > 0.0:
                     lo = mid
                 else:
                     hi = mid
@@ -305,7 +303,12 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
             kap = 0.5 * dl * mud * (N0 + n1 * tb)
             sig, ex, ez, slides = _return_map(zx, zz, kap, w11, w12, w22)
-            sig = 0.0
+            if slides:
+                # a sharp turn without a stop: the sub-step ends here, sliding on
+                stop = False
+                turned = True
+            else:
+                sig = 0.0
         elif stop:
             # chatter guard: the pallet stops inside its return map and stays so to the end
             sig = 0.0
@@ -335,9 +338,17 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         if sig > 0.0:
             dx = ex
             dz = ez
+        if turned:
+            n_ph += 1
+            n_sub = 0
+            if want_ev and n_ev < ev.shape[0]:
+                ev[n_ev, 0] = t
+                ev[n_ev, 1] = _EV_TURN
+            n_ev += 1
         if not stop:
             continue
         n_ph += 1
+        n_sub = 0
         if n_ph > _MAX_PHASES:
             # keep it stopped (stuck) for the rest of the step
             stuck = True
@@ -405,12 +416,60 @@ def _rho(bx, bz, Jx, Jz, stuck0, yx, yz, h, m, g11, g12, g22, Agx, Agz, Jrx, Jrz
 
 
 @_JIT
+def _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1, ag0x, ag0z, ag1x,
+            ag1z, jx, jz, g11, g12, g22, nd, ev, vscale):
+    """F'(β) by one-sided finite differences (step scaled to β)."""
+    eps = 1e-7 * (abs(bx) + abs(bz) + vscale / h)
+    ra = _pallet_F(bx + eps, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
+                   ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+    F11 = (ra[0] - r[0]) / eps
+    F21 = (ra[1] - r[1]) / eps
+    F12 = 0.0
+    F22 = 0.0
+    if nd == 2:
+        rb = _pallet_F(bx, bz + eps, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
+                       ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+        F12 = (rb[0] - r[0]) / eps
+        F22 = (rb[1] - r[1]) / eps
+    return F11, F12, F21, F22
+
+
+@_JIT
+def _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd):
+    """∂ρ/∂β = h(I + mG) − G F' (stuck reference) or h I − G F'."""
+    if stuck0:
+        a11 = h * (1.0 + m * g11)
+        a12 = h * m * g12
+        a21 = h * m * g12
+        a22 = h * (1.0 + m * g22)
+    else:
+        a11 = h
+        a12 = 0.0
+        a21 = 0.0
+        a22 = h
+    a11 -= g11 * F11 + g12 * F21
+    a12 -= g11 * F12 + g12 * F22
+    a21 -= g12 * F11 + g22 * F21
+    a22 -= g12 * F12 + g22 * F22
+    if nd == 1:
+        a12 = 0.0
+        a21 = 0.0
+        a22 = 1.0
+    return a11, a12, a21, a22
+
+
+@_JIT
 def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                  ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, out):
+                  ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, out, warm, want_D):
     """Impulse of the pallet for the support velocity change ``y`` (eq. 4.1–4.2, β and J
     together). Writes ``out``: [Jx, Jz, D11, D12, D21, D22, stuck, s1x, s1z, d1x, d1z, Ux, Uz,
-    lx, lz, bx, bz, n_ev, iterations] (D = ∂J/∂y). Returns True when the pallet stays stuck
-    through the step with no event (then D = m I exactly)."""
+    lx, lz, bx, bz, n_ev, iterations] (D = ∂J/∂y, written only when ``want_D``). ``warm``:
+    start from the β in ``out[15:17]`` (the last solution of this pallet in this step).
+    Returns True when the pallet stays stuck through the step with no event (then D = m I).
+
+    A sliding reference first iterates β ← (y + G (J(β) − J_ref)) / h, which contracts
+    unless the pallet is about to stop (J then depends strongly on β); Newton's method with a
+    finite-difference Jacobian takes over when it does not."""
     Agx = 0.5 * h * (ag0x + ag1x)
     Agz = 0.5 * h * (ag0z + ag1z)
     if nd == 1:
@@ -458,7 +517,9 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         Jrz = -mud * 0.5 * h * (N0 + N1) * d0z
         if nd == 1:
             Jrz = 0.0
-    # Newton on β with a finite-difference Jacobian of F, backtracking on |ρ|
+    if warm:
+        bx = out[15]
+        bz = out[16] if nd == 2 else 0.0
     vscale = h * (abs(ag0x) + abs(ag1x) + abs(ag0z) + abs(ag1z) + mus * (N0 + N1) / m) \
         + abs(yx) + abs(yz) + 1e-300
     tol = 1e-13 * vscale
@@ -467,47 +528,42 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
     rx, rz = _rho(bx, bz, r[0], r[1], stuck0, yx, yz, h, m, g11, g12, g22, Agx, Agz, Jrx, Jrz)
     nrm = abs(rx) + abs(rz)
     n_it = 0
+    if not stuck0:
+        # fixed point β = (y + G (J − J_ref)) / h
+        for _fp in range(8):
+            if nrm <= tol:
+                break
+            n_it += 1
+            nbx = (yx + g11 * (r[0] - Jrx) + g12 * (r[1] - Jrz)) / h
+            nbz = (yz + g12 * (r[0] - Jrx) + g22 * (r[1] - Jrz)) / h if nd == 2 else 0.0
+            rn = _pallet_F(nbx, nbz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
+                           ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+            nrx, nrz = _rho(nbx, nbz, rn[0], rn[1], stuck0, yx, yz, h, m, g11, g12, g22,
+                            Agx, Agz, Jrx, Jrz)
+            nn = abs(nrx) + abs(nrz)
+            if nn > 0.5 * nrm:
+                break  # no contraction: Newton below
+            bx = nbx
+            bz = nbz
+            r = rn
+            rx = nrx
+            rz = nrz
+            nrm = nn
+    # Newton on β with a finite-difference Jacobian of F, backtracking on |ρ|
+    have_fp = False
     F11 = 0.0
     F12 = 0.0
     F21 = 0.0
     F22 = 0.0
     for _it in range(60):
-        n_it += 1
-        # F'(β) by finite differences (one-sided, step scaled to β)
-        eps = 1e-7 * (abs(bx) + abs(bz) + vscale / h)
-        ra = _pallet_F(bx + eps, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                       ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
-        F11 = (ra[0] - r[0]) / eps
-        F21 = (ra[1] - r[1]) / eps
-        if nd == 2:
-            rb = _pallet_F(bx, bz + eps, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                           ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
-            F12 = (rb[0] - r[0]) / eps
-            F22 = (rb[1] - r[1]) / eps
-        else:
-            F12 = 0.0
-            F22 = 0.0
         if nrm <= tol:
             break
-        # Jρ = h(I + mG) − G F' (stuck ref) or h I − G F'
-        if stuck0:
-            a11 = h * (1.0 + m * g11)
-            a12 = h * m * g12
-            a21 = h * m * g12
-            a22 = h * (1.0 + m * g22)
-        else:
-            a11 = h
-            a12 = 0.0
-            a21 = 0.0
-            a22 = h
-        a11 -= g11 * F11 + g12 * F21
-        a12 -= g11 * F12 + g12 * F22
-        a21 -= g12 * F11 + g22 * F21
-        a22 -= g12 * F12 + g22 * F22
-        if nd == 1:
-            a12 = 0.0
-            a21 = 0.0
-            a22 = 1.0
+        n_it += 1
+        F11, F12, F21, F22 = _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud,
+                                     N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22,
+                                     nd, ev, vscale)
+        have_fp = True
+        a11, a12, a21, a22 = _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd)
         det = a11 * a22 - a12 * a21
         if det == 0.0:
             break
@@ -531,41 +587,30 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         rx = nrx
         rz = nrz
         nrm = nn
+        have_fp = False
     # final evaluation with the events
     r = _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                   ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, True)
-    # D = F' Jρ⁻¹ (J as a function of y)
-    if stuck0:
-        a11 = h * (1.0 + m * g11)
-        a12 = h * m * g12
-        a21 = h * m * g12
-        a22 = h * (1.0 + m * g22)
-    else:
-        a11 = h
-        a12 = 0.0
-        a21 = 0.0
-        a22 = h
-    a11 -= g11 * F11 + g12 * F21
-    a12 -= g11 * F12 + g12 * F22
-    a21 -= g12 * F11 + g22 * F21
-    a22 -= g12 * F12 + g22 * F22
-    if nd == 1:
-        a12 = 0.0
-        a21 = 0.0
-        a22 = 1.0
-    det = a11 * a22 - a12 * a21
-    if det == 0.0:
-        det = 1e-300
-    b11 = a22 / det
-    b12 = -a12 / det
-    b21 = -a21 / det
-    b22 = a11 / det
+    if want_D:
+        if not have_fp:
+            F11, F12, F21, F22 = _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus,
+                                         mud, N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, g11,
+                                         g12, g22, nd, ev, vscale)
+        # D = F' Jρ⁻¹ (J as a function of y)
+        a11, a12, a21, a22 = _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd)
+        det = a11 * a22 - a12 * a21
+        if det == 0.0:
+            det = 1e-300
+        b11 = a22 / det
+        b12 = -a12 / det
+        b21 = -a21 / det
+        b22 = a11 / det
+        out[2] = F11 * b11 + F12 * b21
+        out[3] = F11 * b12 + F12 * b22
+        out[4] = F21 * b11 + F22 * b21
+        out[5] = F21 * b12 + F22 * b22
     out[0] = r[0]
     out[1] = r[1]
-    out[2] = F11 * b11 + F12 * b21
-    out[3] = F11 * b12 + F12 * b22
-    out[4] = F21 * b11 + F22 * b21
-    out[5] = F21 * b12 + F22 * b22
     out[6] = 1.0 if r[2] else 0.0
     out[7] = r[3]
     out[8] = r[4]

@@ -81,3 +81,54 @@ def rack_global_loads(model, mass: sp.spmatrix) -> np.ndarray:  # noqa: ANN001
                 e[d] = 1.0
                 cols.append(mass @ e)
     return np.column_stack(cols) if cols else np.zeros((n, 0))
+
+
+def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # noqa: ANN001
+               vertical: bool = False, check: str = "static"):  # noqa: ANN201
+    """The local basis of a compiled rack (slices by upright line, the pallets' friction
+    patterns, the ground loads and a uniform load on every level for the far field), with its
+    error measured against the full model (``check``: "static", "full" or "none")."""
+    from seisrack.dynamics.local.basis import (
+        DEFAULT_PATCH,
+        DEFAULT_TOL,
+        local_basis,
+        measure_error,
+    )
+
+    sl = rack_sliders(model)
+    n = model.K_sparse.shape[0]
+    M = model.M_sparse
+    extra = sl.attached_mass(n)
+    if getattr(model, "is_3d", False):
+        infl = [model.r_x, model.r_z] + ([model.r_y] if vertical else [])
+    else:
+        infl = [model.r_x] + ([model.r_y] if vertical else [])
+    loads = np.column_stack([M @ r for r in infl])
+    pats = sl.patterns(n)
+    b = local_basis(M, model.C_sparse, model.K_sparse, rack_slices(model), loads, pats,
+                    global_loads=rack_global_loads(model, M + extra), mass_extra=extra,
+                    tol=DEFAULT_TOL if tol is None else tol,
+                    patch=DEFAULT_PATCH if patch is None else patch)
+    if check != "none":
+        err = measure_error(b, M, model.K_sparse, loads, pats, mass_extra=extra,
+                            n_modes=8 if check == "full" else 0)
+        object.__setattr__(b, "error", err)
+    return b
+
+
+def simulate_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None,  # noqa: ANN001, ANN201
+                  basis=None, **kw):  # noqa: ANN001, ANN003
+    """:func:`~seisrack.dynamics.local.simulate_local` on a compiled rack: ``ground`` (n_t,
+    n_dir) the down-aisle (and, 3D, cross-aisle) accelerations [m/s²] on the analysis grid;
+    other keywords as ``simulate_local``."""
+    from seisrack.dynamics.local.engine import simulate_local
+
+    is3d = getattr(model, "is_3d", False)
+    infl = np.array([model.r_x, model.r_z]) if is3d else np.array([model.r_x])
+    if basis is None:
+        basis = rack_basis(model, vertical=vertical_accel is not None)
+    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse, rack_sliders(model),
+                          dt=dt, ground=np.reshape(ground, (np.shape(ground)[0], -1)),
+                          influence=infl, vertical_accel=vertical_accel,
+                          vertical_influence=None if vertical_accel is None else model.r_y,
+                          g=model.g, basis=basis, **kw)
