@@ -82,27 +82,27 @@ def _onset(l0x, l0z, l1x, l1z, n0, n1, mus, t0, t1):
 
 
 @_JIT
-def _return_map(zx, zz, kap, w11, w12, w22):
-    """End velocity of a trapezoidal sliding sub-step: σ ŝ + κ W ŝ = z, |ŝ| = 1, σ >= 0.
-    Returns (σ, ŝx, ŝz, slides): when |(κW)⁻¹ z| <= 1 the pallet stops inside the sub-step
-    (σ = 0, ŝ = (κW)⁻¹ z normalised)."""
+def _eig2(w11, w12, w22):
+    """Eigenvalues (wa, wb) and the rotation (cos, sin) of the 2 × 2 SPD W."""
+    if w12 == 0.0:
+        return w11, w22, 1.0, 0.0
+    tr = 0.5 * (w11 + w22)
+    dif = 0.5 * (w11 - w22)
+    rad = np.sqrt(dif * dif + w12 * w12)
+    ang = 0.5 * np.arctan2(w12, dif)
+    return tr + rad, tr - rad, np.cos(ang), np.sin(ang)
+
+
+@_JIT
+def _return_map(zx, zz, kap, wa, wb, ca, sa):
+    """End velocity of a trapezoidal sliding sub-step: σ ŝ + κ W ŝ = z, |ŝ| = 1, σ >= 0,
+    with W = R diag(wa, wb) Rᵀ (``_eig2``). Returns (σ, ŝx, ŝz, slides): when |(κW)⁻¹ z| <= 1
+    the pallet stops inside the sub-step (σ = 0, ŝ = (κW)⁻¹ z normalised)."""
     if kap <= 0.0:
         zn = np.sqrt(zx * zx + zz * zz)
         if zn == 0.0:
             return 0.0, 1.0, 0.0, False
         return zn, zx / zn, zz / zn, True
-    # eigenvectors of W
-    if w12 == 0.0:
-        wa, wb, ca, sa = w11, w22, 1.0, 0.0
-    else:
-        tr = 0.5 * (w11 + w22)
-        dif = 0.5 * (w11 - w22)
-        rad = np.sqrt(dif * dif + w12 * w12)
-        wa = tr + rad
-        wb = tr - rad
-        ang = 0.5 * np.arctan2(w12, dif)
-        ca = np.cos(ang)
-        sa = np.sin(ang)
     da = ca * zx + sa * zz
     db = -sa * zx + ca * zz
     ka = kap * wa
@@ -151,7 +151,8 @@ def _release(w11, w12, w22, cx, cz, f):
 
 @_JIT
 def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-              ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, want_ev):
+              ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd, ev,
+              want_ev):
     """The pallet over [0, h] for the reference mean acceleration β = (bx, bz).
 
     Returns (Jx, Jz, stuck, s1x, s1z, d1x, d1z, Ux, Uz, lx, lz, n_ev): impulse, end state
@@ -165,6 +166,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         w12 = 0.0
         w22 = 1.0 / m
     i11, i12, i22 = _inv2(w11, w12, w22)
+    wa, wb, ca, sa = _eig2(w11, w12, w22)
     n1 = (N1 - N0) / h
     # a_ref(τ) = β + (τ − h/2) j ; a_g(τ) = ag0 + (ag1 − ag0) τ / h
     ar0x = bx - 0.5 * h * jx
@@ -197,6 +199,34 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
     l0z = i12 * c0x + i22 * c0z
     l1x = i11 * c1x + i12 * c1z
     l1z = i12 * c1x + i22 * c1z
+    # the holding force the contact decisions read (onset, stick at a stop): with the
+    # support's reference acceleration filtered, ã(τ) = (β_prev + β)/2 + τ (β − β_prev2)/(2h),
+    # which cancels a period-2h residue of stiff directions exactly and is O(h²) for a smooth
+    # one (theory §4.4); the impulse keeps the unfiltered ℓ
+    f0x = l0x
+    f0z = l0z
+    f1x = l1x
+    f1z = l1z
+    if usef:
+        dax = 0.5 * (bpx + bx) - ar0x
+        daz = 0.5 * (bpz + bz) - ar0z
+        dsx = 0.5 * (bx - bqx) / h - jx
+        dsz = 0.5 * (bz - bqz) / h - jz
+        if stuck0:
+            # c changes by (I + mG) Δa: λ by m Δa
+            f0x += m * dax
+            f0z += m * daz
+            f1x += m * dsx
+            f1z += m * dsz
+        else:
+            # c changes by Δa: λ by W⁻¹ Δa
+            f0x += i11 * dax + i12 * daz
+            f0z += i12 * dax + i22 * daz
+            f1x += i11 * dsx + i12 * dsz
+            f1z += i12 * dsx + i22 * dsz
+        if nd == 1:
+            f0z = 0.0
+            f1z = 0.0
     t = 0.0
     Jx = 0.0
     Jz = 0.0
@@ -217,11 +247,13 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
     n_ph = 0
     n_sub = 0
     grid = h / _NSUB
+    t_rel = -1.0  # time of the last release from zero relative velocity
+    hold = False  # no more onsets in this step (see the stop decision below)
     while t < h:
         if stuck:
             te = h
-            if n_ph <= _MAX_PHASES:
-                r = _onset(l0x, l0z, l1x, l1z, N0, n1, mus, t, h)
+            if n_ph <= _MAX_PHASES and not hold:
+                r = _onset(f0x, f0z, f1x, f1z, N0, n1, mus, t, h)
                 if r >= 0.0:
                     te = r
             Jx += l0x * (te - t) + 0.5 * l1x * (te * te - t * t)
@@ -231,6 +263,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                 break
             n_ph += 1
             n_sub = 0
+            t_rel = t
             # slip: the force from the disc problem at te
             cx = c0x + c1x * t
             cz = c0z + c1z * t
@@ -265,7 +298,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
         zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
         kap = 0.5 * dl * mud * (N0 + n1 * tb)
-        sig, ex, ez, slides = _return_map(zx, zz, kap, w11, w12, w22)
+        sig, ex, ez, slides = _return_map(zx, zz, kap, wa, wb, ca, sa)
         # the direction at the start of the sub-step: a velocity that turns by more than a
         # right angle inside it passed near zero, where a stop (1D: a reversal) can hide
         pnx = sx
@@ -288,7 +321,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                 zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
                 zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
                 kap = 0.5 * dl * mud * (N0 + n1 * mid)
-                _s, ex2, ez2, sl2 = _return_map(zx, zz, kap, w11, w12, w22)
+                _s, ex2, ez2, sl2 = _return_map(zx, zz, kap, wa, wb, ca, sa)
                 if sl2 and pnx * ex2 + pnz * ez2 > 0.0:
                     lo = mid
                 else:
@@ -302,7 +335,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             zx = sx + 0.5 * dl * (w11 * lax + w12 * laz - cax - cbx)
             zz = sz + 0.5 * dl * (w12 * lax + w22 * laz - caz - cbz)
             kap = 0.5 * dl * mud * (N0 + n1 * tb)
-            sig, ex, ez, slides = _return_map(zx, zz, kap, w11, w12, w22)
+            sig, ex, ez, slides = _return_map(zx, zz, kap, wa, wb, ca, sa)
             if slides:
                 # a sharp turn without a stop: the sub-step ends here, sliding on
                 stop = False
@@ -358,9 +391,21 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             t = h
             break
         # decide at the stop: stuck if the holding force is within mu_s N
-        hx = l0x + l1x * t
-        hz = l0z + l1z * t
+        hx = f0x + f1x * t
+        hz = f0z + f1z * t
         cap = mus * (N0 + n1 * t)
+        if t - t_rel <= 1e-9 * h:
+            # released and stopped at once: the filtered holding force (which releases) and
+            # the support's motion (which stops it) disagree, as with a ringing stiff
+            # direction; the pallet keeps its contact to the end of the step and the
+            # zero-length slide is not an event
+            stuck = True
+            hold = True
+            sx = 0.0
+            sz = 0.0
+            if n_ev > 0:
+                n_ev -= 1
+            continue
         if hx * hx + hz * hz <= cap * cap:
             stuck = True
             sx = 0.0
@@ -381,6 +426,7 @@ def _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
                 dz = -laz / fn
             sx = 0.0
             sz = 0.0
+            t_rel = t
             if want_ev and n_ev < ev.shape[0]:
                 ev[n_ev, 0] = t
                 ev[n_ev, 1] = _EV_TURN
@@ -417,18 +463,20 @@ def _rho(bx, bz, Jx, Jz, stuck0, yx, yz, h, m, g11, g12, g22, Agx, Agz, Jrx, Jrz
 
 @_JIT
 def _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1, ag0x, ag0z, ag1x,
-            ag1z, jx, jz, g11, g12, g22, nd, ev, vscale):
+            ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd, ev, vscale):
     """F'(β) by one-sided finite differences (step scaled to β)."""
     eps = 1e-7 * (abs(bx) + abs(bz) + vscale / h)
     ra = _pallet_F(bx + eps, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                   ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+                   ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd,
+                  ev, False)
     F11 = (ra[0] - r[0]) / eps
     F21 = (ra[1] - r[1]) / eps
     F12 = 0.0
     F22 = 0.0
     if nd == 2:
         rb = _pallet_F(bx, bz + eps, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                       ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+                       ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd,
+                  ev, False)
         F12 = (rb[0] - r[0]) / eps
         F22 = (rb[1] - r[1]) / eps
     return F11, F12, F21, F22
@@ -460,7 +508,8 @@ def _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd):
 
 @_JIT
 def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                  ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, out, warm, want_D):
+                  ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd,
+                  ev, out, warm, want_D):
     """Impulse of the pallet for the support velocity change ``y`` (eq. 4.1–4.2, β and J
     together). Writes ``out``: [Jx, Jz, D11, D12, D21, D22, stuck, s1x, s1z, d1x, d1z, Ux, Uz,
     lx, lz, bx, bz, n_ev, iterations] (D = ∂J/∂y, written only when ``want_D``). ``warm``:
@@ -490,7 +539,19 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         l0z = m * (ag0z + bz - 0.5 * h * jz)
         l1x = m * ((ag1x - ag0x) / h + jx)
         l1z = m * ((ag1z - ag0z) / h + jz)
-        if _onset(l0x, l0z, l1x, l1z, N0, (N1 - N0) / h, mus, 0.0, h) < 0.0:
+        f0x = l0x
+        f0z = l0z
+        f1x = l1x
+        f1z = l1z
+        if usef:
+            f0x = m * (ag0x + 0.5 * (bpx + bx))
+            f0z = m * (ag0z + 0.5 * (bpz + bz))
+            f1x = m * ((ag1x - ag0x) / h + 0.5 * (bx - bqx) / h)
+            f1z = m * ((ag1z - ag0z) / h + 0.5 * (bz - bqz) / h)
+        if nd == 1:
+            f0z = 0.0
+            f1z = 0.0
+        if _onset(f0x, f0z, f1x, f1z, N0, (N1 - N0) / h, mus, 0.0, h) < 0.0:
             out[0] = m * (Agx + yx)
             out[1] = m * (Agz + yz)
             out[2] = m
@@ -522,9 +583,10 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         bz = out[16] if nd == 2 else 0.0
     vscale = h * (abs(ag0x) + abs(ag1x) + abs(ag0z) + abs(ag1z) + mus * (N0 + N1) / m) \
         + abs(yx) + abs(yz) + 1e-300
-    tol = 1e-13 * vscale
+    tol = 1e-12 * vscale
     r = _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                  ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+                  ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd,
+                  ev, False)
     rx, rz = _rho(bx, bz, r[0], r[1], stuck0, yx, yz, h, m, g11, g12, g22, Agx, Agz, Jrx, Jrz)
     nrm = abs(rx) + abs(rz)
     n_it = 0
@@ -537,7 +599,8 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             nbx = (yx + g11 * (r[0] - Jrx) + g12 * (r[1] - Jrz)) / h
             nbz = (yz + g12 * (r[0] - Jrx) + g22 * (r[1] - Jrz)) / h if nd == 2 else 0.0
             rn = _pallet_F(nbx, nbz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                           ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+                           ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11,
+                           g12, g22, nd, ev, False)
             nrx, nrz = _rho(nbx, nbz, rn[0], rn[1], stuck0, yx, yz, h, m, g11, g12, g22,
                             Agx, Agz, Jrx, Jrz)
             nn = abs(nrx) + abs(nrz)
@@ -560,8 +623,8 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             break
         n_it += 1
         F11, F12, F21, F22 = _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud,
-                                     N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22,
-                                     nd, ev, vscale)
+                                     N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx,
+                                     bqz, usef, g11, g12, g22, nd, ev, vscale)
         have_fp = True
         a11, a12, a21, a22 = _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd)
         det = a11 * a22 - a12 * a21
@@ -574,7 +637,8 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
             nbx = bx + alpha * px
             nbz = bz + alpha * pz
             rn = _pallet_F(nbx, nbz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                           ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, False)
+                           ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11,
+                           g12, g22, nd, ev, False)
             nrx, nrz = _rho(nbx, nbz, rn[0], rn[1], stuck0, yx, yz, h, m, g11, g12, g22,
                             Agx, Agz, Jrx, Jrz)
             nn = abs(nrx) + abs(nrz)
@@ -590,12 +654,13 @@ def _pallet_solve(yx, yz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
         have_fp = False
     # final evaluation with the events
     r = _pallet_F(bx, bz, stuck0, s0x, s0z, d0x, d0z, h, m, mus, mud, N0, N1,
-                  ag0x, ag0z, ag1x, ag1z, jx, jz, g11, g12, g22, nd, ev, True)
+                  ag0x, ag0z, ag1x, ag1z, jx, jz, bpx, bpz, bqx, bqz, usef, g11, g12, g22, nd,
+                  ev, True)
     if want_D:
         if not have_fp:
             F11, F12, F21, F22 = _fprime(bx, bz, r, stuck0, s0x, s0z, d0x, d0z, h, m, mus,
-                                         mud, N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, g11,
-                                         g12, g22, nd, ev, vscale)
+                                         mud, N0, N1, ag0x, ag0z, ag1x, ag1z, jx, jz, bpx,
+                                         bpz, bqx, bqz, usef, g11, g12, g22, nd, ev, vscale)
         # D = F' Jρ⁻¹ (J as a function of y)
         a11, a12, a21, a22 = _jrho(stuck0, h, m, g11, g12, g22, F11, F12, F21, F22, nd)
         det = a11 * a22 - a12 * a21
