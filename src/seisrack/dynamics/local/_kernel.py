@@ -198,7 +198,7 @@ def _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R):
 @_JIT
 def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud, dt, pat,
               ser, agp, gz, resume, q, v, dvp, stuck, sv, dirn, uu, lam, beta, jerk, nprev,
-              Dp, energy, t_offset, max_events, out_q, out_v, out_u, out_s, out_lam,
+              Dp, rows, energy, t_offset, max_events, out_q, out_v, out_u, out_s, out_lam,
               out_stuck, out_e, ev_time, ev_pallet, ev_kind, stats):
     """Integrate ``ser.shape[0] - 1`` steps of length ``dt``.
 
@@ -208,7 +208,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
     forces ``mass * max(gz, 0)``. State (read when ``resume``, written back): q, v, dvp (the
     last Δv), stuck, sv (relative velocity), dirn (sliding direction), uu (sliding), lam (end
     force), beta and jerk (the support's reference acceleration and its rate), nprev, Dp
-    (∂J/∂y of the last step), energy [input, damping, friction]. Outputs per step row;
+    (∂J/∂y of the last step), rows (2, m, _NOUT) the pallets' last local solutions (their
+    warm starts), energy [input, damping, friction]. Outputs per step row;
     events; ``stats``: steps, Newton iterations, factorisations, local solves, line-search
     evaluations. Returns (status, n_events, last row written).
     """
@@ -236,8 +237,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
     tmp = np.empty(N)
     fbar = np.empty(N)
     vbar = np.empty(N)
-    outs = np.zeros((m, _NOUT))
-    outs_n = np.zeros((m, _NOUT))
+    outs = rows[0]
+    outs_n = rows[1]
     ev = np.zeros((m, 8, 2))
     Gc = np.zeros((m, 3))
     gstamp = np.full(m, -1, dtype=np.int64)
@@ -265,6 +266,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             Dp[p, 3] = mass[p] if nd == 2 else 0.0
         for i in range(N):
             dvp[i] = 0.0
+        rows[:, :, :] = 0.0
     _write(0, q, v, uu, sv, lam, stuck, energy, Md, Mo, Kd, Ko, sizes, offsets, P, ps, nd,
            mass, tmp, out_q, out_v, out_u, out_s, out_lam, out_stuck, out_e)
     k_done = 0

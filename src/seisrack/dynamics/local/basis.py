@@ -24,9 +24,12 @@ from seisrack.errors import InputError, SolverError
 _LOG = logging.getLogger(__name__)
 
 #: relative energy below which a direction of a slice is dropped (of a unit-energy load
-#: response): 0.2 kept the static energy error of the load patterns within 10 % and the
-#: lowest 20 frequencies within 0.4 % on the warehouse racks (docs/theory/local_engine.md §6)
-DEFAULT_TOL = 0.2
+#: response). On the 150-pallet warehouse example, 20 s of two EC8 components: at 0.1 (782
+#: vectors) every pallet's peak sliding is within 0.84 mm of the planar engine with its
+#: basis tightened to 3e-2, level peaks within 0.14 %, the same 38 falls within 4 ms; at 0.2
+#: (696 vectors) 134 of 150 pallets within 1 mm and level peaks within 0.9 %
+#: (docs/theory/local_engine.md §6)
+DEFAULT_TOL = 0.1
 #: slices on each side of a slice in its patch
 DEFAULT_PATCH = 1
 

@@ -219,6 +219,7 @@ def simulate_local(
     jerk = np.zeros((m, 4))  # the jerk estimate and the last difference of beta
     nprev = np.zeros(m, dtype=np.int64)
     Dp = np.zeros((m, 4))
+    rows_state = np.zeros((2, m, 19))
     energy = np.zeros(3)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
@@ -243,7 +244,7 @@ def simulate_local(
                 *mats, sizes, offsets, P, ps, nd, mass, mus, mud, float(dt), pat,
                 np.ascontiguousarray(ser[rows]), np.ascontiguousarray(agp[rows]),
                 np.ascontiguousarray(gz[rows]), start > 0, q, v, dvp, stuck, sv, dirn, uu,
-                lam, beta, jerk, nprev, Dp, energy, start * float(dt), left, *outs,
+                lam, beta, jerk, nprev, Dp, rows_state, energy, start * float(dt), left, *outs,
                 ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:], stats)
             n_ev += int(ne)
             status = int(st)
