@@ -248,15 +248,15 @@ def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
     m = int(model.pallet_mass.size)
     mus = np.broadcast_to(
         np.asarray(model.pallet_mu_static if mu is None else mu, dtype=float), (m,))
-    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
+    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs[0]) for d in dofs}
     vertical_mass: dict[int, float] = {}  # OpenSees node -> summed pallet vertical mass
     p_beam, p_node, p_ele, p_lev = [], [], [], []
     for j in range(m):
         mass = float(model.pallet_mass[j])
-        v_owner = owner[int(model.pallet_vdof[j])]
+        v_owner = owner[int(model.pallet_vdof[j, 0])]
         vn = int(tags[v_owner[0]])
         vertical_mass[vn] = vertical_mass.get(vn, 0.0) + mass
-        h_owner = owner[int(model.pallet_dof[j])]
+        h_owner = owner[int(model.pallet_dofs[j, 0, 0])]
         bn = int(tags[h_owner[0]])
         x, y = mesh.nodes[h_owner[0]]
         pn = next_node
@@ -277,12 +277,13 @@ def build(model, mu: float | np.ndarray | None = None, k_init: float = 1e8,
             p_ele.append(ele)
         p_beam.append(bn)
         p_node.append(pn)
-        p_lev.append(level_of_dof[int(model.pallet_dof[j])])
+        p_lev.append(level_of_dof[int(model.pallet_dofs[j, 0, 0])])
     for vn, mv in vertical_mass.items():  # once per node: ops.mass replaces, it does not add
         ops.mass(vn, 0.0, mv, 0.0)
 
     # Levels: one node per distinct horizontal DOF (as seisrack's level_dofs)
-    levels = [np.array([int(tags[owner[int(d)][0]]) for d in dofs]) for dofs in model.level_dofs]
+    levels = [np.array([int(tags[owner[int(d)][0]]) for d in dofs])
+              for dofs in model.level_dofs[0]]
 
     a0, a1 = (float(c) for c in model.damping_coefficients)
     if a0 == 0.0:

@@ -80,8 +80,9 @@ def _case(path: str, motion, mu: float | None = None, tol: float | None = None, 
           repeat: int = 1, label: str | None = None) -> dict:
     import numpy as np
 
-    from seisrack.analysis.rack3d import run_rack_3d
-    from seisrack.dynamics.planar import PlanarSliders, planar_basis
+    from seisrack.analysis import run_rack
+    from seisrack.analysis.prepare import rack_sliders
+    from seisrack.dynamics.run_basis import planar_basis
     from seisrack.model import compile_rack, load_rack, with_friction
 
     spec = load_rack(Path(path) if Path(path).is_absolute() else ROOT / path)
@@ -90,18 +91,17 @@ def _case(path: str, motion, mu: float | None = None, tol: float | None = None, 
     model = compile_rack(spec)
     basis = "auto"
     if tol is not None:
-        sl = PlanarSliders(model.pallet_dof_x, model.pallet_dof_z, model.pallet_mass,
-                           model.pallet_mu_static, model.pallet_mu_dynamic)
+        sl = rack_sliders(model)
         M = model.M_sparse
         basis = planar_basis(M, model.K_sparse, sl, np.column_stack([M @ model.r_x,
                                                                      M @ model.r_z]),
                              "reduced", tol=tol)
-    run_rack_3d(model, motion.__class__(motion.x[:201], motion.z[:201], None, motion.dt,
-                                        motion.names), save_every=None, basis=basis)  # warm
+    run_rack(model, motion.__class__(motion.x[:201], motion.z[:201], None, motion.dt,
+                                     motion.names), save_every=None, basis=basis)  # warm
     walls, cpus = [], []
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
-        resp = run_rack_3d(model, motion, save_every=None, basis=basis)
+        resp = run_rack(model, motion, save_every=None, basis=basis)
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     h = resp.history
@@ -109,7 +109,7 @@ def _case(path: str, motion, mu: float | None = None, tol: float | None = None, 
             "pallets": model.n_pallets, "basis": h.basis["size"], "events": len(h.events),
             "substeps": h.n_substeps, "falls": len(resp.falls), "wall": min(walls),
             "wall_med": float(np.median(walls)), "cpu": min(cpus), "work": h.work,
-            "peak": float(resp.peak_sliding[:, 2].max()) if resp.n_pallets else 0.0}
+            "peak": float(resp.pallet_peak_sliding().max()) if resp.n_pallets else 0.0}
 
 
 def main() -> None:

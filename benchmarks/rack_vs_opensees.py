@@ -84,7 +84,7 @@ def seisrack_run(model, rec: Record, repeat: int):
     k = int(round(rec.dt / DT))
     t = np.arange((rec.n - 1) * k + 1) * DT
     ag = np.interp(t, rec.time, rec.accel)
-    sl = Sliders(model.pallet_dof, model.pallet_mass, model.pallet_mu_static,
+    sl = Sliders(model.pallet_dofs[:, 0, 0], model.pallet_mass, model.pallet_mu_static,
                  model.pallet_mu_dynamic)
     best_engine = np.inf
     for _ in range(repeat):

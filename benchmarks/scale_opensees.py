@@ -78,7 +78,7 @@ def run_opensees(
     """
     ag = np.asarray(ag, dtype=float)
     n_steps = int(ag.size - 1)
-    n_level = len(model.level_dofs)
+    n_level = model.n_level
     out: dict[str, Any] = {
         "program": "OpenSeesPy", "status": "ok", "wall_time_s": math.nan,
         "build_time_s": math.nan, "analysis_time_s": math.nan, "n_steps": n_steps,

@@ -19,7 +19,7 @@ import scipy.sparse.linalg as sla
 from analysis_inputs import paper_model, short_record
 from seisrack.analysis import run_rack
 from seisrack.analysis.peaks import design_history
-from seisrack.analysis.rack import lowpass, pallet_bays
+from seisrack.analysis.rack import lowpass
 from seisrack.fe.recovery import base_reactions, design_operators, element_end_forces
 from seisrack.model import compile_rack, load_rack, with_friction
 
@@ -119,16 +119,15 @@ def test_pallet_ids_and_labels(three, three_run):
     assert [p["id"] for p in s["pallets"]] == list(range(1, 19))
     assert labels[:4] == ["L1-B1-S1", "L1-B1-S2", "L1-B2-S1", "L1-B2-S2"]
     assert labels[-1] == "L3-B3-S2" and len(set(labels)) == 18
-    assert pallet_bays(three).tolist() == [0, 0, 1, 1, 2, 2] * 3
-    risk = three_run.pallets_at_risk()
-    assert s["pallets_at_risk"] == [j + 1 for j in risk]
+    assert three.pallet_bay.tolist() == [0, 0, 1, 1, 2, 2] * 3
+    assert s["pallets_at_risk"] == three_run.pallets_at_risk()  # 1-based ids, as everywhere
 
 
 def test_warehouse_labels_unique():
     model = compile_rack(load_rack("examples/warehouse_rack.toml"))
-    bay = pallet_bays(model)
+    bay = model.pallet_bay
     assert bay.min() == 0 and bay.max() == 19
-    x = model.nodes[model.pallet_node, 0]
+    x = model.nodes[model.pallet_node[:, 0], 0]
     assert np.all((x > model.upright_x[bay]) & (x < model.upright_x[bay + 1]))
 
 

@@ -97,12 +97,12 @@ def test_fall_check_flags_pallet_beyond_its_limit():
     assert free.pallets_at_risk() == []
     d["pallets"][0]["sliding_limit"] = 0.005
     resp = run_rack(model_from(d), short_record(), rigid_companion=False)
-    assert resp.pallets_at_risk() == [0]
+    assert resp.pallets_at_risk() == [1]  # 1-based ids, as every output numbers pallets
     util = resp.fall_utilisation()
     assert util[0] == pytest.approx(peak[0] / 0.005, rel=1e-9) and util[0] > 1
     assert np.all(util[1:] < 1)
     s = resp.summary()
-    # the summary numbers pallets from 1 (issue 14); the library method is 0-based
+    # the summary numbers pallets from 1 (issue 14), as the library method does
     assert s["pallets_at_risk"] == [1] and s["pallets"][0]["fall_utilisation"] > 1
 
 

@@ -27,7 +27,7 @@ def test_json_output(capsys):
 def test_table_output(capsys):
     assert main(["modal", str(PAPER_RACK), "--modes", "2"]) == 0
     out = capsys.readouterr().out
-    assert "period [s]" in out and "cumul." in out
+    assert "period [s]" in out and "cum. x" in out
     assert "0.65" in out.splitlines()[3]
 
 

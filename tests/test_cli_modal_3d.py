@@ -62,9 +62,15 @@ def test_plot_functions_return_axes():
     plt.close("all")
 
 
-def test_report_on_3d_rack_is_a_clear_error(capsys):
-    code = main(["report", str(RACK), "--builtin", "elcentro_1940_ns", "--json"])
-    assert code == 2
-    err = json.loads(capsys.readouterr().out)["error"]
-    assert err["field"] == "geometry.depth"
-    assert "seisrack run" in err["message"]
+def test_report_on_3d_rack(tmp_path, capsys):
+    """``seisrack report`` takes a 3D rack (issue 21): the HTML and summary.json are written
+    and the summary is the 3D run's."""
+    out = tmp_path / "r.html"
+    code = main(["report", str(RACK), "--builtin", "elcentro_1940_ns", "--out", str(out),
+                 "--json"])
+    assert code == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["dimension"] == "3D" and s["directions"] == ["down-aisle", "cross-aisle"]
+    assert out.exists() and (tmp_path / "summary.json").exists()
+    assert {r["direction"] for r in s["design_checks"]["checks"][-1]["storeys"]} == {
+        "down-aisle", "cross-aisle"}

@@ -43,7 +43,11 @@ def test_json_keys_per_issue(capsys, rec_csv):
     assert out["sliding_occurred"] is True
     assert isinstance(out["pallets_at_risk"], list)
     assert out["peaks"]["total_friction_force_N"] == pytest.approx(0.3 * 1600 * 9.81)
-    assert out["simplified_check"]["rule_safe"] is True
+    # without the rigid companion run the paper's rule has no alpha, so no verdict (issue 23:
+    # this run's own accelerations, with sliding pallets, were once labelled rigid)
+    sc = out["simplified_check"]
+    assert sc["rule_safe"] is None and sc["assessed"] is False and sc["alpha_rigid"] is None
+    assert sc["alpha_source"].startswith("this run, with sliding pallets")
     assert all(p["mu_static"] == 0.3 for p in out["pallets"])
     assert out["dt_s"] == pytest.approx(0.005) and out["duration_s"] == pytest.approx(5.0)
 
@@ -69,7 +73,8 @@ def test_text_report_flags_pallet_at_risk(tmp_path: Path, capsys, rec_csv):
     assert main(["run", str(rack), "--motion", str(rec_csv), "--mu", "0.3"]) == 0
     out = capsys.readouterr().out
     for text in ("beam displacement", "mm", "m/s²", "kN", "kN·m", "base shear",
-                 "Simplified check", "verdict", "Pallets at risk of falling: 2 (L1-B1-S2)",
+                 "Simplified check", "not assessed", "--rigid-check",
+                 "reached their free distance: 2 (L1-B1-S2)",
                  "beam acceleration (absolute, raw)", "beam acceleration (low-pass 20 Hz)",
                  "interstorey drift ratio", "connector moment", "upright axial force",
                  "upright N with concomitant M"):
@@ -264,7 +269,8 @@ def test_basis_save_every_and_rigid_check(capsys, rec_csv):
     assert red["peaks"]["pallet_sliding_m"] == pytest.approx(full["peaks"]["pallet_sliding_m"],
                                                              rel=5e-3, abs=1e-6)
     assert full["simplified_check"]["alpha_source"].startswith("this run")
-    assert red["simplified_check"]["alpha_source"] == "rigid companion run"
+    assert red["simplified_check"]["alpha_source"].startswith("rigid companion run")
+    assert red["simplified_check"]["rule_safe"] in (True, False)
 
 
 def test_summary_ids_filtered_acceleration_and_design(capsys, rec_csv):

@@ -96,4 +96,6 @@ def test_validate_json_shape(capsys, monkeypatch):
 
 def test_validate_bad_dt(capsys):
     rc, out, _ = _run(capsys, ["validate", "--json", "--dt", "-1"])
-    assert rc == 2 and json.loads(out)["error"]["field"] == "dt"
+    assert rc == 2 and json.loads(out)["error"]["field"] == "--dt"
+    rc, out, _ = _run(capsys, ["validate", "--json", "--dt", "1e-9"])  # 1e10 steps: refused
+    assert rc == 2 and "1e-05" in json.loads(out)["error"]["allowed"]

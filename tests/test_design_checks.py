@@ -34,7 +34,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 def _toy(mu_s: float = 0.3, mu_d: float = 0.25) -> tuple[SimpleNamespace, SimpleNamespace]:
     """One level (DOFs 0 and 1), two modes, one pallet on DOF 0."""
-    model = SimpleNamespace(level_dofs=(np.array([0, 1]),), pallet_dof=np.array([0]),
+    model = SimpleNamespace(level_dofs=((np.array([0, 1]),),), pallet_level=np.array([0]),
                             n_pallets=1, g=9.81, pallet_mu_static=np.array([mu_s]),
                             pallet_mu_dynamic=np.array([mu_d]))
     # mean level shapes: mode 1 (0.3 + 0.3)/2 = 0.3, mode 2 (-0.1 - 0.3)/2 = -0.2
@@ -150,7 +150,7 @@ def test_storey_shear_equals_applied_storey_forces(three_level):
     m = three_level
     F = np.zeros(m.n_dof)
     for lv, force in enumerate((10e3, 20e3, 30e3)):
-        dofs = np.asarray(m.level_dofs[lv])
+        dofs = np.asarray(m.level_dofs[0][lv])
         F[dofs] += force / dofs.size
     u = spla.spsolve(m.K_sparse.tocsc(), F)
     V = np.abs(storey_shear_history(m, u[None, :])[0])

@@ -219,7 +219,7 @@ def test_chunked_run_equals_one_chunk():
     rec = _record(6.0, 2.0)
     t = np.arange(int(round(6.0 / 0.005)) + 1) * 0.005
     ag = np.interp(t, rec.time, rec.accel)
-    sl = Sliders(model.pallet_dof, model.pallet_mass, 0.5, 0.4, friction_rate=5.0)
+    sl = Sliders(model.pallet_dofs[:, 0, 0], model.pallet_mass, 0.5, 0.4, friction_rate=5.0)
     args = (model.M_sparse, model.C_sparse, model.K_sparse, sl)
     kw = dict(dt=0.005, ground_accel=ag, influence=model.r_x, hinges=h)
     one = simulate(*args, **kw)
@@ -278,14 +278,15 @@ def test_hinge_peaks_do_not_depend_on_decimation():
 
 
 def test_study_runs_use_the_hinge_basis():
-    """A study builds the basis once per rack (studies.executors._basis); with nonlinear
-    connections it must be run_rack's hinge-augmented Ritz basis, not the elastic one."""
-    from seisrack.studies.executors import _basis
+    """A study prepares each rack once (seisrack.analysis.prepare_run, as studies.executors
+    does); with nonlinear connections its basis must be the hinge-augmented Ritz basis
+    run_rack builds, not the elastic one."""
+    from seisrack.analysis import prepare_run
 
     model = _nonlinear_rack(0.5)
     rec = _record(8.0, 2.0)
-    bas = _basis(model)
+    prepared = prepare_run(model)
     direct = run_rack(model, rec, dt=0.005)
-    assert bas.size == direct.history.basis["size"] == 16
-    via = run_rack(model, rec, dt=0.005, basis=bas)
+    assert prepared.basis.size == direct.history.basis["size"] == 16
+    via = run_rack(model, rec, dt=0.005, basis=prepared.basis)
     np.testing.assert_array_equal(via.hinges.moment, direct.hinges.moment)

@@ -24,13 +24,24 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from seisrack.dynamics import Sliders, simulate
-from seisrack.dynamics.planar import PlanarSliders, simulate_planar
+from seisrack.dynamics import PlanarSliders, Sliders, simulate
 from seisrack.errors import InputError
 from seisrack.sdof.closed_form import solve_sdof
 
 G = 9.81
 MUS, MUD = 0.35, 0.3
+
+
+def _run_planar(M, C, K, sl, *, ground_x=None, influence_x=None, ground_z=None,
+                influence_z=None, **kw):
+    """The planar scheme through ``simulate``: ground x, z and their influence vectors."""
+    n = np.shape(M)[0]
+    series = [np.zeros(0) if a is None else np.asarray(a, float) for a in (ground_x, ground_z)]
+    n_t = max(a.size for a in series)
+    ag = np.column_stack([a if a.size else np.zeros(n_t) for a in series])
+    infl = np.column_stack([np.zeros(n) if r is None else np.asarray(r, float)
+                            for r in (influence_x, influence_z)])
+    return simulate(M, C, K, sl, ground_accel=ag, influence=infl, **kw)
 
 
 def ax_fn(t):
@@ -115,7 +126,7 @@ def _ref():
 def _on_ground(dt, backend="auto", mus=MUS, mud=MUD, ax=ax_fn, az=az_fn, t_end=T_END):
     t = np.arange(0.0, t_end + dt / 2, dt)
     sl = PlanarSliders([[-1]], [[-1]], 500.0, mus, mud)
-    h = simulate_planar(np.eye(1), np.zeros((1, 1)), np.eye(1) * 100.0, sl, dt=dt,
+    h = _run_planar(np.eye(1), np.zeros((1, 1)), np.eye(1) * 100.0, sl, dt=dt,
                         ground_x=ax(t), influence_x=[0.0], ground_z=az(t), influence_z=[0.0],
                         backend=backend)
     return t, h
@@ -190,7 +201,7 @@ def test_one_axis_on_a_structure_equals_the_1d_engine():
     mass, mus, mud = [400.0, 300.0, 500.0], [0.3, 0.25, 0.2], [0.25, 0.25, 0.15]
     dofx = [0, 1, 1]
     dofz = [2, 3, 3]
-    hp = simulate_planar(M, C, K, PlanarSliders(dofx, dofz, mass, mus, mud), dt=dt,
+    hp = _run_planar(M, C, K, PlanarSliders(dofx, dofz, mass, mus, mud), dt=dt,
                          ground_x=ag, influence_x=[1, 1, 0, 0], basis="full")
     h1 = simulate(M[:2, :2], C[:2, :2], K[:2, :2], Sliders(dofx, mass, mus, mud), dt=dt,
                   ground_accel=ag, method="newmark", basis="full")
@@ -206,10 +217,10 @@ def test_friction_law_in_the_plane():
     dt = 0.002
     t = np.arange(0, 6 + dt / 2, dt)
     sl = PlanarSliders([0, 1], [2, 3], [400.0, 500.0], [0.3, 0.25], [0.22, 0.2])
-    h = simulate_planar(M, C, K, sl, dt=dt, ground_x=0.5 * ax_fn(t), influence_x=[1, 1, 0, 0],
+    h = _run_planar(M, C, K, sl, dt=dt, ground_x=0.5 * ax_fn(t), influence_x=[1, 1, 0, 0],
                         ground_z=0.5 * az_fn(t), influence_z=[0, 0, 1, 1], basis="full")
     f = np.hypot(h.friction[..., 0], h.friction[..., 1])
-    v = np.hypot(h.velocity[..., 0], h.velocity[..., 1])
+    v = np.hypot(h.sliding_v[..., 0], h.sliding_v[..., 1])
     cap_s = sl.mu_static * h.normal
     cap_d = sl.mu_dynamic * h.normal
     assert np.all(f[h.stuck] <= cap_s[h.stuck] * (1 + 1e-9))
@@ -217,7 +228,7 @@ def test_friction_law_in_the_plane():
     assert sliding.sum() > 100 and h.stuck.sum() > 100
     assert np.allclose(f[sliding], cap_d[sliding], rtol=1e-9)
     # the friction opposes the relative velocity (end-of-step directions, to O(dt))
-    cosang = np.einsum("tpc,tpc->tp", h.friction, h.velocity)[sliding] / (f * v)[sliding]
+    cosang = np.einsum("tpc,tpc->tp", h.friction, h.sliding_v)[sliding] / (f * v)[sliding]
     assert np.median(cosang) < -0.999
     assert np.all(v[h.stuck] < 1e-9)
 
@@ -230,8 +241,8 @@ def test_python_twin_equals_numba():
     sl = PlanarSliders([0, 1], [2, 3], [400.0, 500.0], 0.25, 0.2)
     kw = dict(dt=dt, ground_x=ax_fn(t), influence_x=[1, 1, 0, 0], ground_z=az_fn(t),
               influence_z=[0, 0, 1, 1], basis="full")
-    a = simulate_planar(M, C, K, sl, backend="numba", **kw)
-    b = simulate_planar(M, C, K, sl, backend="python", **kw)
+    a = _run_planar(M, C, K, sl, backend="numba", **kw)
+    b = _run_planar(M, C, K, sl, backend="python", **kw)
     assert len(a.events) >= 3
     assert np.allclose(a.sliding, b.sliding, rtol=0, atol=1e-12)
 
@@ -243,8 +254,8 @@ def test_chunks_and_save_every_do_not_change_the_result():
     sl = PlanarSliders([0, 1], [2, 3], [400.0, 500.0], 0.25, 0.2)
     kw = dict(dt=dt, ground_x=ax_fn(t), influence_x=[1, 1, 0, 0], ground_z=az_fn(t),
               influence_z=[0, 0, 1, 1], basis="full")
-    a = simulate_planar(M, C, K, sl, **kw)
-    b = simulate_planar(M, C, K, sl, chunk_steps=37, save_every=5, **kw)
+    a = _run_planar(M, C, K, sl, **kw)
+    b = _run_planar(M, C, K, sl, chunk_steps=37, save_every=5, **kw)
     assert np.array_equal(b.sliding, a.sliding[b.sample_index])
     assert b.t[-1] == pytest.approx(4.0)
 
@@ -267,16 +278,16 @@ def test_bad_run_input():
     sl = PlanarSliders([0], [7], 100.0, 0.3)
     ag = np.zeros(11)
     with pytest.raises(InputError) as exc:
-        simulate_planar(M, C, K, sl, dt=0.01, ground_x=ag, influence_x=[1, 1, 0, 0])
+        _run_planar(M, C, K, sl, dt=0.01, ground_x=ag, influence_x=[1, 1, 0, 0])
     assert exc.value.field == "sliders.dof_z"
     sl = PlanarSliders([0], [2], 100.0, 0.3)
     with pytest.raises(InputError) as exc:
-        simulate_planar(M, C, K, sl, dt=0.01, ground_x=ag)
-    assert exc.value.field == "influence_x"
+        simulate(M, C, K, sl, dt=0.01, ground_accel=ag)
+    assert exc.value.field == "influence"
     Cn = C.copy()
     Cn[0, 3] = Cn[3, 0] = 5e3
     with pytest.raises(InputError) as exc:
-        simulate_planar(M, Cn, K, sl, dt=0.01, ground_x=ag, influence_x=[1, 1, 0, 0],
+        _run_planar(M, Cn, K, sl, dt=0.01, ground_x=ag, influence_x=[1, 1, 0, 0],
                         basis="full")
     assert exc.value.field == "C"
 
@@ -288,7 +299,7 @@ def test_vertical_component_scales_the_friction_like_the_1d_engine():
     ag = 4.0 * np.sin(2 * np.pi * 1.1 * t)
     av = 3.0 * np.sin(2 * np.pi * 3.3 * t)
     kw = dict(dt=dt, vertical_accel=av, basis="full")
-    hp = simulate_planar(M, C, K, PlanarSliders([0, 1], [2, 3], [400.0, 300.0], 0.3, 0.25),
+    hp = _run_planar(M, C, K, PlanarSliders([0, 1], [2, 3], [400.0, 300.0], 0.3, 0.25),
                          ground_x=ag, influence_x=[1, 1, 0, 0], **kw)
     h1 = simulate(M[:2, :2], C[:2, :2], K[:2, :2], Sliders([0, 1], [400.0, 300.0], 0.3, 0.25),
                   ground_accel=ag, method="newmark", **kw)

@@ -19,8 +19,9 @@ from seisrack.model import compile_rack, load_rack
 from seisrack.motion import Record, load_builtin_record
 
 _DIR = Path(__file__).parent.parent / "examples"
-#: rack files (study files, ``study_*.toml``, are run by tests/test_study_*.py)
-EXAMPLES = sorted(p for p in _DIR.glob("*.toml") if not p.name.startswith("study_"))
+#: rack files (study files, ``study_*.toml``, are run by tests/test_study_*.py; warehouse
+#: files, ``site_*.toml``, are loaded by tests/test_warehouse.py)
+EXAMPLES = sorted(p for p in _DIR.glob("*.toml") if not p.name.startswith(("study_", "site_")))
 STUDIES = sorted(_DIR.glob("study_*.toml"))
 
 

@@ -175,10 +175,10 @@ def _opensees_namespace(model) -> dict:
     from seisrack.export import opensees_script
 
     script = opensees_script(model, pallets="rigid")
-    old = 'ops.geomTransf("Linear", 1)'
-    assert script.count(old) == 1
     ns: dict = {"__name__": "paper_rack_ops"}
-    exec(compile(script.replace(old, 'ops.geomTransf("PDelta", 1)'), "rack_ops.py", "exec"), ns)
+    exec(compile(script, "rack_ops.py", "exec"), ns)
+    assert ns["GEOM_TRANSF"] == "Linear"
+    ns["GEOM_TRANSF"] = "PDelta"  # the script's switch: OpenSees' chord term
     return ns
 
 

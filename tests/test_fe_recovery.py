@@ -22,8 +22,8 @@ def paper():
 
 def _lateral(model, total: float = H_LOAD) -> tuple[np.ndarray, np.ndarray]:
     P = np.zeros(model.n_dof)
-    P[model.pallet_dof] += total / model.n_pallets  # the pallets push the beam sideways
-    np.add.at(P, model.pallet_vdof, -model.pallet_mass * model.g)  # and load it vertically
+    P[model.pallet_dofs[:, 0, 0]] += total / model.n_pallets  # the pallets push the beam sideways
+    np.add.at(P, model.pallet_vdof[:, 0], -model.pallet_mass * model.g)  # and load it vertically
     return P, np.linalg.solve(model.K, P)
 
 

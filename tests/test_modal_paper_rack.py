@@ -51,8 +51,9 @@ def test_shapes_are_mass_normalised_and_ordered(model, modes):
     assert phi.T @ Mt @ phi == pytest.approx(np.eye(model.n_dof), abs=1e-8)
     assert np.all(np.diff(modes.periods) <= 0)  # mode 1 = longest period
     assert modes.frequencies == pytest.approx(1 / modes.periods)
-    assert phi[model.pallet_dof, 0] == pytest.approx(np.full(4, phi[model.pallet_dof[0], 0]),
-                                                      rel=1e-3)  # beam moves as a block
+    dofs = model.pallet_dofs[:, 0, 0]
+    assert phi[dofs, 0] == pytest.approx(np.full(4, phi[dofs[0], 0]),
+                                         rel=1e-3)  # beam moves as a block
 
 
 def test_first_period_converged_in_subdivisions():
@@ -67,8 +68,8 @@ def test_first_period_converged_in_subdivisions():
 def test_rigid_pallet_sdof_estimate(model, modes):
     """T1 ≈ 2π √(m / K_lat): lateral stiffness from a static push, total horizontal mass."""
     P = np.zeros(model.n_dof)
-    P[model.pallet_dof] = 250.0
+    P[model.pallet_dofs[:, 0, 0]] = 250.0
     u = np.linalg.solve(model.K, P)
-    k_lat = 1000.0 / u[model.pallet_dof].mean()
+    k_lat = 1000.0 / u[model.pallet_dofs[:, 0, 0]].mean()
     t_sdof = 2 * math.pi * math.sqrt(modes.total_mass_x / k_lat)
     assert modes.periods[0] == pytest.approx(t_sdof, rel=0.01)

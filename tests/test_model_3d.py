@@ -21,9 +21,7 @@ import pytest
 from seisrack.errors import InputError
 from seisrack.fe.modal import modal_analysis
 from seisrack.model import compile_rack, rack_from_dict
-from seisrack.model.compile3d import require_2d
 from seisrack.model.frame_model import FrameModel
-from seisrack.model.frame_model3d import FrameModel3D
 
 TOL = 0.005
 
@@ -66,7 +64,7 @@ def test_down_aisle_periods_equal_the_2d_model(pattern):
     d3 = rack_3d(pattern)
     m3 = compile_rack(rack_from_dict(d3))
     m2 = compile_rack(rack_from_dict(equivalent_2d(d3)))
-    assert isinstance(m3, FrameModel3D) and isinstance(m2, FrameModel)
+    assert type(m3) is type(m2) is FrameModel
     r3, r2 = modal_analysis(m3, 30), modal_analysis(m2, 12)
     t3 = r3.periods[np.array(r3.direction) == "down-aisle"]
     t2 = _down_aisle(r2.periods, r2.mass_participation)
@@ -160,15 +158,29 @@ def test_2d_rack_refuses_3d_keys():
     assert exc.value.field == "pallets[0].depth"
 
 
-def test_time_history_refused_for_3d():
-    spec = rack_from_dict(rack_3d())
-    with pytest.raises(InputError, match="2D rack"):
-        require_2d(spec)
-    with pytest.raises(InputError, match="2D rack"):
-        require_2d(compile_rack(spec))
-    require_2d(rack_from_dict(equivalent_2d(rack_3d())))  # 2D: no error
-    with pytest.raises(InputError, match="2D rack"):
-        compile_rack(spec).pallet_dof  # noqa: B018  (what the 2D time history asks first)
+def test_one_model_type_whose_dimension_is_data():
+    """A 2D and a 3D rack compile to the same FrameModel; the shapes carry the dimension."""
+    m3 = compile_rack(rack_from_dict(rack_3d()))
+    m2 = compile_rack(rack_from_dict(equivalent_2d(rack_3d())))
+    assert (m2.ndm, m2.n_dir, m2.pallet_dofs.shape[1:], m2.mesh.ndf) == (2, 1, (1, 1), 3)
+    assert (m3.ndm, m3.n_dir, m3.pallet_dofs.shape[1:], m3.mesh.ndf) == (3, 2, (2, 2), 6)
+    assert m2.r_z is None and m3.r_z is not None
+    assert m3.directions == ("down-aisle", "cross-aisle")
+    assert len(m3.level_dofs) == 2 and len(m2.level_dofs) == 1
+    # two upright columns per line in 3D (front and rear), one in 2D
+    assert m3.n_column == 2 * m2.n_column
+
+
+@pytest.mark.parametrize("key, table, feature", [
+    ("hysteresis", {"beam_to_upright": {"law": "elastic-plastic", "yield_moment": 2500.0}},
+     "nonlinear connections"),
+])
+def test_a_feature_not_built_for_3d_is_refused_by_name(key, table, feature):
+    d = rack_3d()
+    d[key] = table
+    with pytest.raises(InputError, match=feature) as exc:
+        compile_rack(rack_from_dict(d))
+    assert "3D racks" in str(exc.value) and exc.value.field == key
 
 
 def test_spine_and_loading_footprint():

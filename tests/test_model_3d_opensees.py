@@ -20,11 +20,11 @@ import math
 import numpy as np
 import pytest
 
-from seisrack.fe.assembly3d import assemble_sparse_3d
+from seisrack.fe.assembly import assemble_sparse
+from seisrack.fe.mesh import FrameMesh
 from seisrack.fe.modal import modal_analysis, modal_from_matrices
 from seisrack.model import compile_rack, rack_from_dict
 from seisrack.model.bracing import _pattern_members
-from seisrack.model.rack_mesh3d import Mesh3D
 
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("openseespy") is None,
                                 reason="openseespy not installed (pip install '.[bench]')")
@@ -43,9 +43,10 @@ def _sections(ip_equals_j: bool = True) -> dict:
 
 
 def _rack(pattern="Z", *, levels=(2.0,), bays=(1.8, 1.8), base_cross=None, spine=False,
-          joint=160e3, base=160e3, ip_equals_j=True) -> dict:
-    pallets = [{"mass": 400.0, "bay": b, "level": lev, "position": x, "mu_static": 0.6,
-                "mu_dynamic": 0.6, "depth": 1.2, "overhang": 0.05}
+          joint=160e3, base=160e3, ip_equals_j=True, rows=1) -> dict:
+    pallets = [{"mass": 400.0 - 100.0 * (r - 1), "bay": b, "level": lev, "position": x,
+                "mu_static": 0.6, "mu_dynamic": 0.6, "depth": 1.2, "overhang": 0.05, "row": r}
+               for r in range(1, rows + 1)
                for lev in range(1, len(levels) + 1) for b in range(1, len(bays) + 1)
                for x in (0.45, 1.35)]
     d = {"material": {"E": E, "density": RHO, "poisson": NU},
@@ -58,6 +59,10 @@ def _rack(pattern="Z", *, levels=(2.0,), bays=(1.8, 1.8), base_cross=None, spine
          "pallets": pallets}
     if base_cross is not None:
         d["connections"]["base_cross"] = base_cross
+    if rows == 2:  # back to back: spacers 0.3 m long at 0.7 and 2.0 m
+        d["sections"]["spacer"] = {"A": 304e-6}
+        d["geometry"].update(rows=2, row_spacer={"length": 0.3, "section": "spacer",
+                                                 "heights": [0.7, 2.0]})
     if spine:
         d["bracing"].update(spine=True, spine_section="spine", spine_bays=[1])
     return d
@@ -67,7 +72,7 @@ def _spring(ops, tag: int, k: float) -> None:
     ops.uniaxialMaterial("Elastic", tag, k)
 
 
-def _ops_periods(mesh: Mesh3D, n: int, *, k_joint: float, k_base: float, k_cross: float,
+def _ops_periods(mesh: FrameMesh, n: int, *, k_joint: float, k_base: float, k_cross: float,
                  lumped: dict[int, float]) -> np.ndarray:
     """First ``n`` periods [s] of the peer model (see the module docstring)."""
     import openseespy.opensees as ops
@@ -149,6 +154,9 @@ CASES = {
     # seisrack's default twist inertia (Ip = Iy + Iz) against OpenSees' (ρ J L / 3):
     # the member twist inertia barely matters for the rack's modes (measured 5e-5)
     "paper_Z_default_Ip": {"ip_equals_j": False},
+    # back-to-back rows (issue 21): the spacers are bars between the rows' inner uprights, the
+    # second row carries lighter pallets (300 kg) so the rows are not twins
+    "two_rows": {"rows": 2, "spine": True},
 }
 
 
@@ -199,16 +207,16 @@ def test_braced_upright_frame_alone_matches_opensees(pattern):
     ne, nt = len(el), len(tr)
     k_base = 160e3
     base_rot = [dofs[at[(s, 0.0)]][c] for s in (0, 1) for c in (3, 5)]
-    mesh = Mesh3D(nodes=np.array(nodes), node_dofs=np.array(dofs), elements=np.array(el),
+    mesh = FrameMesh(nodes=np.array(nodes), node_dofs=np.array(dofs), elements=np.array(el),
                   E=np.full(ne, E), G=np.full(ne, G), A=np.full(ne, up["A"]),
-                  Iy=np.full(ne, up["Iy"]), Iz=np.full(ne, up["I"]), J=np.full(ne, up["J"]),
+                  Iy=np.full(ne, up["Iy"]), I=np.full(ne, up["I"]), J=np.full(ne, up["J"]),
                   Ip=np.full(ne, up["J"]), density=np.full(ne, RHO),
                   vecxz=np.tile([0.0, 0.0, 1.0], (ne, 1)), trusses=np.array(tr),
                   truss_E=np.full(nt, E), truss_A=np.full(nt, br["A"]),
                   truss_density=np.full(nt, RHO),
                   springs=np.array([[d, -1] for d in base_rot]),
                   spring_k=np.full(4, k_base), n_dof=n_dof)
-    K, M = assemble_sparse_3d(mesh)
+    K, M = assemble_sparse(mesh)
     tops = [at[(s, ys[-1])] for s in (0, 1)]
     Mt = M.tolil()
     for node in tops:

@@ -69,13 +69,13 @@ def test_layout_and_pallet_nodes(model):
     assert model.level_y == pytest.approx([2.0])
     assert np.sum(model.element_kind == UPRIGHT) == 3 * 4
     assert np.sum(model.element_kind == BEAM) == 2 * 4
-    assert model.nodes[model.pallet_node] == pytest.approx(
+    assert model.nodes[model.pallet_node[:, 0]] == pytest.approx(
         np.array([[0.45, 2.0], [1.35, 2.0], [2.25, 2.0], [3.15, 2.0]]))
     assert model.pallet_mass == pytest.approx([400.0] * 4)
     assert model.pallet_mu_static == pytest.approx([0.6] * 4)
-    assert set(model.pallet_dof) <= set(model.level_dofs[0])
-    assert model.r_x[model.pallet_dof] == pytest.approx(1.0)
-    assert model.r_y[model.pallet_vdof] == pytest.approx(1.0)
+    assert set(model.pallet_dofs[:, 0, 0]) <= set(model.level_dofs[0][0])
+    assert model.r_x[model.pallet_dofs[:, 0, 0]] == pytest.approx(1.0)
+    assert model.r_y[model.pallet_vdof[:, 0]] == pytest.approx(1.0)
     assert model.r_x @ model.r_y == 0.0
     # base nodes: translations fixed, rotation free (spring to ground)
     assert np.all(model.node_dofs[model.base_nodes, :2] == -1)
@@ -88,14 +88,14 @@ def test_pallet_nodes_inserted_off_the_subdivision_grid(spec):
     d["pallets"][0]["position"] = 0.5
     d["geometry"]["subdivisions"] = 2
     m = compile_rack(rack_from_dict(d))
-    assert m.nodes[m.pallet_node[0]] == pytest.approx([0.5, 2.0])
-    assert m.nodes[m.pallet_node[1]] == pytest.approx([1.35, 2.0])
+    assert m.nodes[m.pallet_node[0, 0]] == pytest.approx([0.5, 2.0])
+    assert m.nodes[m.pallet_node[1, 0]] == pytest.approx([1.35, 2.0])
 
 
 def test_default_sliding_limits_are_free_distances(model):
     # bay 1: pallets span [0.05, 0.85] and [0.95, 1.75]; the uprights at 0 and 1.8
-    assert model.pallet_limit_neg == pytest.approx([0.05, 0.10, 0.05, 0.10])
-    assert model.pallet_limit_pos == pytest.approx([0.10, 0.05, 0.10, 0.05])
+    assert model.layout.limit_neg == pytest.approx([0.05, 0.10, 0.05, 0.10])
+    assert model.layout.limit_pos == pytest.approx([0.10, 0.05, 0.10, 0.05])
 
 
 def test_explicit_sliding_limit_and_width():
@@ -103,9 +103,9 @@ def test_explicit_sliding_limit_and_width():
     d["pallets"][0]["sliding_limit"] = 0.02
     d["pallets"][1]["width"] = 0.9  # spans [0.9, 1.8]: touches the upright
     m = compile_rack(rack_from_dict(d))
-    assert (m.pallet_limit_neg[0], m.pallet_limit_pos[0]) == (0.02, 0.02)
-    assert m.pallet_limit_neg[1] == pytest.approx(0.9 - 0.85)  # to the neighbour's edge
-    assert m.pallet_limit_pos[1] == pytest.approx(0.0, abs=1e-12)
+    assert (m.layout.limit_neg[0], m.layout.limit_pos[0]) == (0.02, 0.02)
+    assert m.layout.limit_neg[1] == pytest.approx(0.9 - 0.85)  # to the neighbour's edge
+    assert m.layout.limit_pos[1] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_stiffness_proportional_damping_at_first_period(model):
@@ -145,8 +145,8 @@ def test_rigid_joint_shares_rotation():
 
 
 def test_compiled_arrays_are_read_only(model):
-    for arr in (model.K, model.M, model.C, model.r_x, model.pallet_dof, model.mesh.nodes,
-                model.level_dofs[0]):
+    for arr in (model.K, model.M, model.C, model.r_x, model.pallet_dofs, model.mesh.nodes,
+                model.level_dofs[0][0]):
         with pytest.raises(ValueError):
             arr[0] = arr[0]
     Mt = model.total_mass_matrix()

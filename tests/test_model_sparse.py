@@ -91,7 +91,7 @@ def test_sparse_matrices_are_read_only(model):
                 part[0] = part[0]
     Mt = model.total_mass_sparse()
     Mt.data[0] += 1.0  # a fresh, writable matrix
-    assert Mt[0, 0] != model.M_sparse[0, 0] or model.pallet_dof.size == 0
+    assert Mt[0, 0] != model.M_sparse[0, 0] or model.pallet_dofs.size == 0
 
 
 def test_compile_forms_no_dense_matrix_and_pickles_without_one(warehouse):

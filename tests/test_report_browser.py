@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from test_report_html import build_case
+from test_report_html import build_case, build_case_3d
 
 CHROMIUM = os.environ.get("SEISRACK_CHROMIUM") or shutil.which("chromium") or (
     "/usr/bin/chromium" if Path("/usr/bin/chromium").exists() else None)
@@ -42,9 +42,10 @@ def _need_browser() -> None:
         pytest.skip(msg)
 
 
-@pytest.fixture(scope="module")
-def rendered(tmp_path_factory):
-    """Write the report and summary.json, open it in Chromium, collect what the page shows."""
+@pytest.fixture(scope="module", params=["2D", "3D"])
+def rendered(request, tmp_path_factory):
+    """Write the report and summary.json of a 2D and of a 3D rack, open it in Chromium,
+    collect what the page shows."""
     _need_browser()
     pytest.importorskip("matplotlib")
     from playwright.sync_api import sync_playwright
@@ -52,7 +53,7 @@ def rendered(tmp_path_factory):
     from seisrack.report.html import write_html_report
     from seisrack.report.rack_io import write_summary_json
 
-    case = build_case()
+    case = build_case() if request.param == "2D" else build_case_3d()
     d = tmp_path_factory.mktemp("browser")
     html = write_html_report(d / "report.html", **case)
     write_summary_json(case["summary"], d / "summary.json")
@@ -96,8 +97,10 @@ def test_no_console_errors(rendered):
 def test_every_figure_rendered(rendered):
     figs = rendered["figures"]
     ids = {f["id"] for f in figs}
-    assert {"fig-elevation", "fig-modes", "fig-record", "fig-spectrum",
-            "fig-histories"} <= ids, f"figures {ids}; screenshot: {rendered['shot']}"
+    want = {"fig-elevation", "fig-modes", "fig-record", "fig-spectrum", "fig-histories"}
+    if rendered["summary"].get("dimension") == "3D":
+        want.add("fig-plan")
+    assert want <= ids, f"figures {ids}; screenshot: {rendered['shot']}"
     for f in figs:
         assert f["n"] > 0, f"figure {f['id']} has no image; screenshot: {rendered['shot']}"
         for tag, w, h, nw, nh, complete in f["sizes"]:

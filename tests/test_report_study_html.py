@@ -195,7 +195,7 @@ def test_refuses_to_overwrite_without_force(study, capsys):
     capsys.readouterr()
     assert summary_main([str(root), *ARGS, "--report", str(report)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error:") and "--force" in err and "Traceback" not in err
+    assert err.startswith("seisrack: error:") and "--force" in err and "Traceback" not in err
     assert err.strip().count("\n") == 0  # one paragraph
     assert report.read_bytes() == before
     # --force rewrites it: mark the old file so the check does not hang on the clock (the
@@ -210,10 +210,15 @@ def test_refuses_to_overwrite_without_force(study, capsys):
 def test_cli_bad_report_path(study, tmp_path, capsys):
     from seisrack.cli import main
 
+    (tmp_path / "afile").write_text("")
     code = main(["study", "summary", str(study["root"]), "--boot", "0", "--no-plots",
-                 "--report", str(tmp_path / "missing" / "r.html")])
+                 "--report", str(tmp_path / "afile" / "r.html")])
     err = capsys.readouterr().err
-    assert code == 2 and "Create the folder" in err and "Traceback" not in err
+    assert code == 2 and "is a file, not a folder" in err and "Traceback" not in err
+    # a missing folder is created (as `seisrack run --out` does)
+    assert main(["study", "summary", str(study["root"]), "--boot", "0", "--no-plots",
+                 "--report", str(tmp_path / "missing" / "r.html")]) == 0
+    assert (tmp_path / "missing" / "r.html").is_file()
 
 
 def test_no_bootstrap_no_band(study, tmp_path):

@@ -147,8 +147,10 @@ def test_cli_runs_then_resumes(study: Path, reference: pa.Table, tmp_path: Path,
 def test_dask_scheduler_address_same_table(study: Path, reference: pa.Table,
                                            tmp_path: Path) -> None:
     distributed = pytest.importorskip("dask.distributed")
+    # a scheduler this test starts itself, on the loopback interface only
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
         s = run_study(load_study(study), tmp_path, scheduler=cluster.scheduler_address,
                       progress=False)
     assert s.executor == "dask" and s.runs_ok == 12

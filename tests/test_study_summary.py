@@ -212,8 +212,9 @@ def test_summary_main_bad_input(tmp_path, capsys, case):
     code = summary_main(args)
     err = capsys.readouterr().err
     assert code == 2
-    assert err.startswith("error:") and "Traceback" not in err
-    assert ("d_slide" in err) if case == "bad_d" else (str(target) in err)
+    assert err.startswith("seisrack: error:") and "Traceback" not in err
+    assert err.count("\n") == 1
+    assert ("--d-slide" in err) if case == "bad_d" else (str(target) in err)
 
 
 def test_local_reader_dedups_and_sorts(tmp_path):

@@ -1,3 +1,5 @@
 from seisrack.cli import main
 
-raise SystemExit(main())
+# guarded: a process pool started with "spawn" (Dask's nannies) imports the main module again
+if __name__ == "__main__":
+    raise SystemExit(main())

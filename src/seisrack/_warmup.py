@@ -26,13 +26,13 @@ def warmup() -> dict[str, float]:
                  ground_accel=np.sin(np.arange(60) * 0.2), backend="numba", method=method)
     timings["stick-slip engine"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from seisrack.dynamics.planar import PlanarSliders, simulate_planar
+    from seisrack.dynamics import PlanarSliders
 
     K4 = np.kron(np.eye(2), K)
-    simulate_planar(np.eye(4), 0.01 * K4, K4, PlanarSliders([0, 1], [2, 3], 1.0, 0.3),
-                    dt=0.01, ground_x=np.sin(np.arange(60) * 0.2), influence_x=[1, 1, 0, 0],
-                    ground_z=np.cos(np.arange(60) * 0.3), influence_z=[0, 0, 1, 1],
-                    backend="numba", basis="full")
+    ground = np.column_stack([np.sin(np.arange(60) * 0.2), np.cos(np.arange(60) * 0.3)])
+    simulate(np.eye(4), 0.01 * K4, K4, PlanarSliders([0, 1], [2, 3], 1.0, 0.3), dt=0.01,
+             ground_accel=ground, influence=np.array([[1, 0], [1, 0], [0, 1], [0, 1]]),
+             backend="numba", basis="full")
     timings["planar stick-slip engine (3D racks)"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     from seisrack.motion import response_spectrum

@@ -1,13 +1,14 @@
-"""Falls and impacts of the pallets of a 3D rack, tracked over every step of a run (issue 11,
-item 4; geometry: :mod:`seisrack.model.pallet_layout3d`).
+"""Falls and impacts of the pallets, tracked over every step of a run (geometry:
+:mod:`seisrack.model.pallet_layout`).
 
-A pallet *falls* cross-aisle the first time its sliding passes its fall distance towards the
-front aisle (−z) or the rear (+z). A down-aisle *impact* is the first time a gap closes
-between two neighbouring pallets, or between an end pallet and its upright; it is reported
-with its closing speed. Crossing times are interpolated linearly between samples. The run
-does not follow a pallet beyond either event (it stays on its beams in the model), so what
-happens to a pallet after its fall or impact is not physical: the tracker reports first
-occurrences only.
+A pallet of a 3D rack *falls* cross-aisle the first time its sliding passes its fall distance
+towards −z or +z: into the front aisle, the flue of a back-to-back rack or the rear aisle
+(:meth:`~seisrack.model.pallet_layout.PalletLayout.fall_side`). A down-aisle *impact* is the
+first time a gap closes between two neighbouring pallets, or between an end pallet and its
+upright; it is reported with its closing speed. Crossing times are interpolated linearly
+between samples. The run does not follow a pallet beyond either event (it stays on its beams in
+the model), so what happens to a pallet after its fall or impact is not physical: the tracker
+reports first occurrences only.
 """
 
 from __future__ import annotations
@@ -16,17 +17,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from seisrack.model.pallet_layout3d import UPRIGHT, PalletLayout3D
+from seisrack.model.pallet_layout import FLUE, UPRIGHT, PalletLayout
 
 
 @dataclass(frozen=True)
 class Fall:
-    """Pallet ``pallet`` (0-based) falls towards ``side`` ("front" aisle, −z, or "rear", +z)
-    at ``time_s``."""
+    """Pallet ``pallet`` (0-based) falls at ``time_s`` into ``side``: "front aisle" (−z),
+    "flue" (between the rows of a back-to-back rack) or "rear aisle" (+z)."""
 
     pallet: int
     time_s: float
     side: str
+
+    @property
+    def into_aisle(self) -> bool:
+        """True for a fall into either aisle (the falls that hurt people), False into the
+        flue."""
+        return self.side != FLUE
 
 
 @dataclass(frozen=True)
@@ -56,27 +63,33 @@ def _first_crossing(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ContactTracker:
-    """Peaks of sliding (x, z, magnitude), falls and impacts over the chunks of a run."""
+    """Falls (3D racks) and down-aisle impacts over the chunks of a run (an ``on_chunk``
+    callback)."""
 
-    def __init__(self, layout: PalletLayout3D, n_pallets: int) -> None:
+    def __init__(self, layout: PalletLayout, n_pallets: int) -> None:
         self.layout = layout
         m = n_pallets
-        self.peak = np.zeros((m, 3))
         self.fall_time = np.full(m, np.nan)
         self.fall_side = np.zeros(m, dtype=np.int64)  # -1 front, +1 rear
         k = layout.contact_gap.size
         self.impact_time = np.full(k, np.nan)
         self.impact_speed = np.full(k, np.nan)
 
-    def update(self, t: np.ndarray, u: np.ndarray, v: np.ndarray) -> None:
-        """One chunk: times (k,), sliding and sliding velocity (k, m, 2)."""
+    def __call__(self, chunk) -> None:  # noqa: ANN001
+        """One chunk of the engine (``on_chunk``); the sliding velocity is asked only where an
+        impact happens (on a line it costs a product with the basis)."""
+        line = chunk.sliding.ndim == 2  # sliders on a line: down-aisle only
+
+        def velocity() -> np.ndarray:
+            return chunk.sliding_v[:, :, None] if line else chunk.sliding_v
+
+        self.update(chunk.t, chunk.sliding[:, :, None] if line else chunk.sliding, velocity)
+
+    def update(self, t: np.ndarray, u: np.ndarray, v) -> None:  # noqa: ANN001
+        """One chunk: times (k,), sliding (k, m, n_dir) and the sliding velocity (the same
+        shape, or a callable giving it)."""
         if u.shape[1] == 0:
             return
-        ax = np.abs(u)
-        np.maximum(self.peak[:, 0], ax[:, :, 0].max(axis=0), out=self.peak[:, 0])
-        np.maximum(self.peak[:, 1], ax[:, :, 1].max(axis=0), out=self.peak[:, 1])
-        np.maximum(self.peak[:, 2], np.hypot(u[:, :, 0], u[:, :, 1]).max(axis=0),
-                   out=self.peak[:, 2])
         lay = self.layout
         open_ = np.flatnonzero(np.isnan(self.fall_time) & np.isfinite(lay.fall_front))
         if open_.size:
@@ -90,15 +103,19 @@ class ContactTracker:
                         self.fall_time[p] = tr
                         self.fall_side[p] = sign
         todo = np.flatnonzero(np.isnan(self.impact_time))
-        if todo.size:
+        # a closure u_left - u_right - gap is at most 2 max|u| - gap: most chunks stop here
+        if todo.size and 2.0 * float(np.abs(u[:, :, 0]).max(initial=0.0)) >= float(
+                lay.contact_gap[todo].min()):
             ux = np.zeros((t.size, u.shape[1] + 1))
-            vx = np.zeros_like(ux)
             ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
-            vx[:, :-1] = v[:, :, 0]
             left, right = lay.contact_left[todo], lay.contact_right[todo]
             close = ux[:, left] - ux[:, right] - lay.contact_gap[todo]
-            speed = vx[:, left] - vx[:, right]
             cols, rows = _first_crossing(close)
+            if cols.size == 0:
+                return
+            vx = np.zeros_like(ux)
+            vx[:, :-1] = (v() if callable(v) else v)[:, :, 0]
+            speed = vx[:, left] - vx[:, right]
             grid = np.arange(t.size)
             for c, r in zip(cols, rows, strict=True):
                 self.impact_time[todo[c]] = float(np.interp(r, grid, t))
@@ -107,7 +124,7 @@ class ContactTracker:
     def falls(self) -> list[Fall]:
         idx = np.flatnonzero(np.isfinite(self.fall_time))
         out = [Fall(int(p), float(self.fall_time[p]),
-                    "front" if self.fall_side[p] < 0 else "rear") for p in idx]
+                    self.layout.fall_side(int(p), int(self.fall_side[p]))) for p in idx]
         return sorted(out, key=lambda f: f.time_s)
 
     def impacts(self) -> list[Impact]:

@@ -1,30 +1,29 @@
-"""Earthquake time history of a rack with sliding pallets (paper §IV): :func:`run_rack`.
+"""Earthquake time history of a rack with sliding pallets (paper §IV): :func:`run_rack`, one
+path for a 2D and a 3D rack.
 
-Glue from a compiled :class:`~seisrack.model.frame_model.FrameModel` and a ground-motion
-:class:`~seisrack.motion.records.Record` to the stick–slip engine, and from the engine's
-:class:`~seisrack.dynamics.results.TimeHistory` to the quantities a rack engineer reads:
-beam-level displacement and acceleration, total pallet–beam contact force, base shear, upright
-moments, and each pallet's sliding against its fall limit.
+Glue from a compiled :class:`~seisrack.model.frame_model.FrameModel` and a ground motion (a
+:class:`~seisrack.motion.records.Record` along the down-aisle axis, or a
+:class:`~seisrack.motion.components.GroundMotion` with a cross-aisle component, a vertical one
+and an incidence angle) to the stick–slip engine, and from the engine's
+:class:`~seisrack.dynamics.results.TimeHistory` to the quantities a rack engineer reads: beam
+level displacement and acceleration, pallet–beam contact force, base shear, upright moments,
+design quantities, each pallet's sliding against its free distances, falls into the aisles and
+down-aisle impacts. Peaks are taken over every step, whatever ``save_every`` keeps.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-import weakref
 from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 
-from seisrack.analysis.hinges import HingePeaks, hinge_response, rack_hinges
-from seisrack.analysis.peaks import (
-    PeakTracker,
-    RackOperators,
-    connection_moment,
-    level_sum,
-    rack_operators,
-)
+from seisrack.analysis.hinges import HingePeaks, hinge_response
+from seisrack.analysis.pallet_contacts import ContactTracker
+from seisrack.analysis.peaks import PeakTracker, connection_moment, level_sum, with_direction
+from seisrack.analysis.prepare import RIGID_MU, PreparedRun, prepare_run, rack_sliders
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
     ACCEL_FILTER_ORDER,
@@ -34,18 +33,18 @@ from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack A
 from seisrack.dynamics import Sliders, TimeHistory, simulate
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.engine import single_blas_thread
-from seisrack.dynamics.hinges import Hinges
 from seisrack.errors import InputError, SolverError
+from seisrack.model.features import require
 from seisrack.model.frame_model import FrameModel
+from seisrack.motion.components import GroundMotion, combine
 from seisrack.motion.records import Record
 
 #: default upper bound of the analysis time step [s]
 DEFAULT_MAX_DT = 0.005
-#: friction coefficient used for the companion run with rigidly held pallets
-RIGID_MU = 1.0e6
 
 
-def analysis_grid(record: Record, dt: float | None, max_dt: float = DEFAULT_MAX_DT) -> int:
+def analysis_grid(record: Record | GroundMotion, dt: float | None,
+                  max_dt: float = DEFAULT_MAX_DT) -> int:
     """Number of analysis steps per record step (the analysis dt is ``record.dt / k``)."""
     if dt is None:
         return max(1, math.ceil(record.dt / max_dt - 1e-9))
@@ -62,7 +61,7 @@ def analysis_grid(record: Record, dt: float | None, max_dt: float = DEFAULT_MAX_
     return int(k)
 
 
-def _resample(a: np.ndarray, k: int) -> np.ndarray:
+def resample(a: np.ndarray, k: int) -> np.ndarray:
     """Linear interpolation of a record onto ``k`` sub-steps per record step (exact for the
     piecewise-linear excitation the engine assumes)."""
     if k == 1:
@@ -72,10 +71,33 @@ def _resample(a: np.ndarray, k: int) -> np.ndarray:
     return np.interp(x, np.arange(n), a)
 
 
+def ground_motion(model: FrameModel, motion: Record | GroundMotion,
+                  vertical: Record | None = None) -> GroundMotion:
+    """``motion`` as the :class:`GroundMotion` the rack takes: a record is its down-aisle
+    component (with ``vertical``); a cross-aisle component needs a 3D rack."""
+    if isinstance(motion, Record):
+        if motion.accel.size < 3:
+            raise InputError("record", f"{motion.accel.size} samples",
+                             "a record of at least 3 samples")
+        motion = combine(motion, None, vertical, fields=("record", "cross", "vertical"))
+    elif isinstance(motion, GroundMotion):
+        if vertical is not None:
+            raise InputError("vertical", vertical.name, "None: the vertical component of a "
+                             "GroundMotion is its own (seisrack.motion.components.combine)")
+        if motion.n < 3:
+            raise InputError("motion", f"{motion.n} samples", "a motion of at least 3 samples")
+    else:
+        raise InputError("record", type(motion).__name__,
+                         "a seisrack Record or GroundMotion (seisrack.motion.components.combine)")
+    if motion.z is not None:
+        require("a cross-aisle ground motion component", model.ndm, "motion", motion.name)
+    return motion
+
+
 @single_blas_thread
 def run_rack(
     model: FrameModel,
-    record: Record,
+    motion: Record | GroundMotion,
     *,
     dt: float | None = None,
     vertical: Record | None = None,
@@ -90,22 +112,25 @@ def run_rack(
     track_energy: bool = True,
     max_memory: float | None = None,
     accel_filter_hz: float = ACCEL_FILTER_HZ,
-    operators: RackOperators | None = None,
+    prepared: PreparedRun | None = None,
 ) -> RackResponse:
-    """Time history of ``model`` under the horizontal ground acceleration ``record``.
+    """Time history of ``model`` (2D or 3D) under the ground motion ``motion``.
 
-    dt: analysis step [s], a whole divisor of ``record.dt`` (default: the largest such step
-        ≤ 5 ms). vertical: optional vertical ground acceleration (same dt and length); the
-        pallets' normal forces become m (g + a_v) and the structure is loaded vertically.
+    motion: a :class:`Record` (the down-aisle component; ``vertical`` optionally gives the
+        vertical one, same dt and length: the pallets' normal forces become m (g + a_v) and the
+        structure is loaded vertically) or a :class:`GroundMotion` (down-aisle, cross-aisle on
+        a 3D rack, vertical, incidence angle).
+    dt: analysis step [s], a whole divisor of the motion's step (default: the largest such
+        step ≤ 5 ms).
     free_vibration: seconds of zero ground motion appended after the record.
     rigid_companion: also run the rack with rigidly held pallets, so that the simplified
-        check's alpha is the designer's (rigid) one; off by default (it costs a second run):
-        the check then uses this run's beam accelerations.
+        check's alpha is the designer's (rigid) one; off by default (it costs a second run),
+        and without it the check gives no verdict.
     progress: called with the number of analysis steps just completed, an increment (as
         ``tqdm.update`` expects), after each chunk of steps of the main run.
     method: time integration of :func:`seisrack.dynamics.simulate` ("auto", "exact" or
         "newmark"); basis: its ``basis`` ("auto": every mode up to 50 DOFs, a reduced
-        load-dependent Ritz basis above).
+        load-dependent Ritz basis above), ignored when ``prepared`` is given.
     save_every: keep every k-th sample of the histories (``None``: first and last only, for
         studies); peaks are always taken over every step. max_memory: bytes the histories may
         take (default half of the available memory, at most 4 GiB); a longer run is refused
@@ -113,103 +138,68 @@ def run_rack(
     accel_filter_hz: [Hz] cut-off of the zero-phase low-pass filter of the reported floor
         accelerations (``beam_acceleration_filtered``; the raw ``beam_acceleration`` is kept),
         applied to the full-rate level accelerations whatever ``save_every`` is.
-    operators: ``rack_operators(model, basis.phi)`` computed once by a caller that runs the
-        same model many times (a study), with ``basis`` given too; default: built here.
+    prepared: :func:`~seisrack.analysis.prepare.prepare_run` of this model's structure, made
+        once by a caller that runs it many times (a study); default: prepared (and cached)
+        here.
     """
     if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
             and accel_filter_hz > 0):
         raise InputError("accel_filter_hz", accel_filter_hz, "a frequency > 0 Hz")
-    if not isinstance(record, Record):
-        raise InputError("record", type(record).__name__, "a seisrack.motion.Record")
-    if record.accel.size < 3:
-        raise InputError(
-            "record", f"{record.accel.size} samples", "a record of at least 3 samples"
-        )
-    if not (math.isfinite(free_vibration) and free_vibration >= 0):
+    if not (isinstance(free_vibration, int | float) and math.isfinite(free_vibration)
+            and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
-    k = analysis_grid(record, dt)
-    h = record.dt / k
-    ag_rec = np.asarray(record.accel, dtype=float)
-    av_rec = None
-    if vertical is not None:
-        if abs(vertical.dt - record.dt) > 1e-9 * record.dt:
-            raise InputError(
-                "vertical.dt", vertical.dt, f"the horizontal record's time step {record.dt:g} s"
-            )
-        if vertical.accel.size != record.accel.size:
-            raise InputError(
-                "vertical", f"{vertical.accel.size} samples",
-                f"the horizontal record's length ({record.accel.size} samples)",
-            )
-        av_rec = np.asarray(vertical.accel, dtype=float)
-    n_pad = int(round(free_vibration / record.dt))
-    if n_pad:
-        ag_rec = np.concatenate([ag_rec, np.zeros(n_pad)])
-        if av_rec is not None:
-            av_rec = np.concatenate([av_rec, np.zeros(n_pad)])
-    ag = _resample(ag_rec, k)
-    av = None if av_rec is None else _resample(av_rec, k)
-    sliders = Sliders(
-        model.pallet_dof, model.pallet_mass, model.pallet_mu_static, model.pallet_mu_dynamic,
-        0.0 if model.pallet_friction_rate is None else model.pallet_friction_rate,
-    )
-    hinges = rack_hinges(model)
-    mats = (model.M_sparse, model.C_sparse, model.K_sparse)
-    common = dict(dt=h, ground_accel=ag, influence=model.r_x, vertical_accel=av,
+    mot = ground_motion(model, motion, vertical)
+    k = analysis_grid(mot, dt)
+    h = mot.dt / k
+    mot = mot.padded(int(round(free_vibration / mot.dt)))
+    nd = model.n_dir
+    ag = np.zeros(((mot.n - 1) * k + 1, nd))
+    for d, a in enumerate(mot.horizontal):
+        ag[:, d] = resample(a, k)
+    av = None if mot.v is None else resample(mot.v, k)
+    if prepared is None:
+        prepared = prepare_run(model, basis=basis, vertical=av is not None)
+    elif prepared.n_dof != model.n_dof:
+        raise InputError("prepared", f"a prepared run of {prepared.n_dof} DOFs",
+                         f"prepare_run(model) of this model ({model.n_dof} DOFs)")
+    ops, bas, hinges = prepared.ops, prepared.basis, prepared.hinges
+    sliders = rack_sliders(model)
+    infl = np.column_stack(model.influence)
+    common = dict(dt=h, ground_accel=ag, influence=infl, vertical_accel=av,
                   vertical_influence=None if av is None else model.r_y, g=model.g,
-                  backend=backend, throw=throw, method=method)
-    # the basis is built once and shared with the companion run (and with the next runs of
-    # the same model: see _model_cache)
-    cache = _model_cache(model)
-    if isinstance(basis, Basis):
-        bas, ops_key = basis, None
-    else:
-        if basis not in ("auto", "full", "reduced"):
-            raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-        key = ("basis", basis, av is not None)
-        bas = cache.get(key)
-        if bas is None:
-            bas = cache[key] = _locked(rack_basis(model, sliders, basis, av, hinges))
-        ops_key = ("operators", *key[1:])
-    pallet_level = cache.get("pallet_level")
-    if pallet_level is None:
-        level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
-        pallet_level = cache["pallet_level"] = _locked(
-            np.array([level_of_dof[int(d)] for d in model.pallet_dof], dtype=int))
-    P = bas.phi[model.pallet_dof, :]  # (m, r) support of each pallet
-    if operators is None:
-        ops = None if ops_key is None else cache.get(ops_key)
-        if ops is None:
-            ops = _locked(rack_operators(model, bas.phi))
-            if ops_key is not None:
-                cache[ops_key] = ops
-    elif operators.level.shape[0] != bas.phi.shape[1]:
-        raise InputError("operators", f"operators for a basis of {operators.level.shape[0]}",
-                         f"rack_operators(model, basis.phi) of this basis ({bas.size} vectors)")
-    else:
-        ops = operators
+                  backend=backend, throw=throw, basis=bas)
+    line = isinstance(sliders, Sliders)
+    if line:
+        common["method"] = method
+    elif method == "exact":
+        require("exact modal propagators (method exact)", model.ndm, "method", method)
     # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
-    # engine takes Newmark for a rack exactly when asked or when the damping has a mass term
-    newmark = method == "newmark" or hinges is not None or sliders.velocity_dependent or (
+    # engine takes Newmark for sliders in the plane, for a rack on a line exactly when asked
+    # or when the damping has a mass term
+    newmark = not line or method == "newmark" or hinges is not None or (
+        sliders.velocity_dependent) or (
         method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
-    tracker = PeakTracker(ops, P, pallet_level, ag, h, smooth=newmark, keep_accel=True,
+    tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
+    contacts = ContactTracker(model.layout, model.n_pallets)
     hpk = None if hinges is None else HingePeaks(hinges, bas.phi)
 
     def on_chunk(chunk) -> None:  # noqa: ANN001
         tracker(chunk)
+        contacts(chunk)
         if hpk is not None:
             hpk(chunk)
 
     try:
-        hist = simulate(*mats, sliders, **common, progress=progress, basis=bas,
-                        save_every=save_every, on_chunk=on_chunk, track_energy=track_energy,
-                        max_memory=max_memory, hinges=hinges)
+        hist = simulate(model.M_sparse, model.C_sparse, model.K_sparse, sliders, **common,
+                        progress=progress, save_every=save_every, on_chunk=on_chunk,
+                        track_energy=track_energy, max_memory=max_memory,
+                        **({"hinges": hinges} if line else {}))
     except InputError as exc:
         if not exc.field.startswith("sliders.friction_rate["):
             raise
         j = int(exc.field.split("[")[1].rstrip("]"))
-        raise InputError(f"friction_rate of pallet {j + 1} (level {pallet_level[j] + 1})",
+        raise InputError(f"friction_rate of pallet {j + 1} (level {model.pallet_level[j] + 1})",
                          exc.value, exc.allowed, source=getattr(model, "title", None) or None,
                          hint=exc.hint) from None
     if (hist.method == "newmark") != newmark:  # pragma: no cover - guards the rule above
@@ -222,55 +212,25 @@ def run_rack(
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
     rigid_peak = None
     if rigid_companion and model.n_pallets:
-        rig = PeakTracker(ops, P, pallet_level, ag, h, smooth=False, design=False)
-        rigid_sl = Sliders(model.pallet_dof, model.pallet_mass, RIGID_MU, RIGID_MU)
-        common["method"] = "exact" if hist.method == "exact" else method
-        simulate(*mats, rigid_sl, **common, basis=bas, save_every=None, on_chunk=rig,
-                 track_energy=False, hinges=hinges)
-        rigid_peak = rig.result()["beam_acceleration"]
-    resp = _response(model, hist, ag, h, record.name, rigid_peak, ops, pallet_level, peaks)
+        rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False)
+        if line:
+            common["method"] = "exact" if hist.method == "exact" else method
+        simulate(model.M_sparse, model.C_sparse, model.K_sparse, rack_sliders(model, RIGID_MU),
+                 **common, save_every=None, on_chunk=rig, track_energy=False,
+                 **({"hinges": hinges} if line else {}))
+        rigid_peak = rig.result()["beam_acceleration_magnitude"]
+    resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
+    squeeze = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
-                   beam_acceleration_filtered=None if acc_filt is None else acc_filt[idx],
-                   hinges=hinge_response(model, hist, hpk))
-
-
-#: per compiled model (weakly held: dropped with the model), what every run of it rebuilds
-#: otherwise: the basis, the recovery and design operators in it, the pallets' levels. A
-#: FrameModel is immutable (frozen, its arrays locked), so these cannot go stale.
-_MODEL_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
-def _model_cache(model: FrameModel) -> dict:
-    try:
-        return _MODEL_CACHE.setdefault(model, {})
-    except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
-        return {}
-
-
-def _locked(obj):  # noqa: ANN001, ANN202
-    """``obj`` with its arrays (through dataclass fields and dict values, recursively) made
-    read-only, since it is shared by every run of a model (returned as is)."""
-    import dataclasses
-
-    def lock(x) -> None:  # noqa: ANN001
-        if isinstance(x, np.ndarray):
-            x.flags.writeable = False
-        elif isinstance(x, dict):
-            for v in x.values():
-                lock(v)
-        elif dataclasses.is_dataclass(x) and not isinstance(x, type):
-            for f in dataclasses.fields(x):
-                v = getattr(x, f.name)
-                if isinstance(v, np.ndarray | dict) or dataclasses.is_dataclass(v):
-                    lock(v)
-
-    lock(obj)
-    return obj
+                   beam_acceleration_filtered=None if acc_filt is None
+                   else squeeze(acc_filt[idx]),
+                   hinges=None if hinges is None else hinge_response(model, hist, hpk))
 
 
 def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:
-    """Zero-phase Butterworth low-pass of ``a: (n_t, k)`` sampled every ``h`` [s] at ``fc`` [Hz].
+    """Zero-phase Butterworth low-pass of ``a: (n_t, ...)`` sampled every ``h`` [s] at ``fc``
+    [Hz], along the first axis.
 
     ``scipy.signal.sosfiltfilt`` (forward and backward: no phase shift, so peaks stay at their
     time; the magnitude response is the square of the order-``order`` filter's, -6 dB at fc).
@@ -294,37 +254,6 @@ def _butter_sos(order: int, fc: float, h: float) -> np.ndarray:
     return butter(order, fc, btype="low", fs=1.0 / h, output="sos")
 
 
-def pallet_bays(model: FrameModel) -> np.ndarray:
-    """(m,) 0-based bay of each pallet, from its node's x between the uprights."""
-    x = np.asarray(model.nodes[model.pallet_node, 0], dtype=float)
-    ux = np.asarray(model.upright_x, dtype=float)
-    return np.clip(np.searchsorted(ux, x, side="right") - 1, 0, max(ux.size - 2, 0))
-
-
-def rack_basis(model: FrameModel, sliders: Sliders, basis: str, av=None,  # noqa: ANN001
-               hinges: Hinges | None = None) -> Basis:
-    """The run's basis: every mode up to the engine's ``AUTO_FULL_MAX_DOF``, else the
-    load-dependent Ritz basis of the ground load, the pallets and (with nonlinear hinges, then
-    ``HINGE_RITZ_BLOCKS`` blocks) unit moments at the hinges."""
-    from seisrack.dynamics.basis import full_basis, reduced_basis
-    from seisrack.dynamics.engine import AUTO_FULL_MAX_DOF, HINGE_RITZ_BLOCKS, HINGE_RITZ_TOL
-
-    if basis not in ("auto", "full", "reduced"):
-        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    if basis == "full" or (basis == "auto" and model.n_dof <= AUTO_FULL_MAX_DOF):
-        return full_basis(model.M_sparse, model.K_sparse)
-    loads = [model.total_mass_sparse() @ model.r_x]
-    if av is not None:
-        loads.append(model.M_sparse @ model.r_y)
-    if hinges is not None:
-        loads.append(hinges.load_vectors(model.n_dof)[:, hinges.law != 0])
-        return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
-                             np.column_stack(loads), blocks=HINGE_RITZ_BLOCKS,
-                             tol=HINGE_RITZ_TOL)
-    return reduced_basis(model.M_sparse, model.K_sparse, sliders.dof, sliders.mass,
-                         np.column_stack(loads))
-
-
 def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
     """Acceleration reported at grid points: ``(v[n+1] - v[n-1]) / (2 h)`` (``a`` at the ends).
 
@@ -335,7 +264,7 @@ def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
     ``(v[n+1] - v[n-1]) / (2h) = (a[n-1] + 2 a[n] + a[n+1]) / 4`` for this scheme, the central
     difference removes that period-2h component exactly and is second-order accurate elsewhere;
     a physical acceleration jump at an event is spread over one step on each side.
-    v, a: (n_t, k) relative velocity and acceleration; returns (n_t, k).
+    v, a: (n_t, ...) relative velocity and acceleration; returns the shape of ``a``.
     """
     out = np.array(a, dtype=float, copy=True)
     if v.shape[0] >= 3:
@@ -343,58 +272,55 @@ def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
     return out
 
 
-def _response(
-    model: FrameModel, hist: TimeHistory, ag: np.ndarray, h: float, name: str,
-    rigid_peak: np.ndarray | None, ops, pallet_level: np.ndarray, peaks: dict,  # noqa: ANN001
-) -> RackResponse:
+def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.ndarray,
+              av: np.ndarray | None, h: float, rigid_peak: np.ndarray | None, ops,  # noqa: ANN001
+              peaks: dict, contacts: ContactTracker) -> RackResponse:
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
-    agk = ag[idx]
-    disp = hist.q @ ops.level
-    vel = hist.qd @ ops.level
-    acc_raw = hist.qdd @ ops.level + agk[:, None]
+    nd = model.n_dir
+    agk = ag[idx]  # (n_t, n_dir)
+
+    def per_dir(ops_d: tuple, x: np.ndarray) -> np.ndarray:
+        return np.stack([x @ o for o in ops_d], axis=-1)
+
+    disp = per_dir(ops.level, hist.q)
+    vel = per_dir(ops.level, hist.qd)
+    acc_raw = per_dir(ops.level, hist.qdd) + agk[:, None, :]
     contiguous = idx.shape[0] == ag.shape[0]
     if hist.method == "newmark" and contiguous:
-        acc = smoothed_acceleration(vel, acc_raw - agk[:, None], h) + agk[:, None]
+        acc = smoothed_acceleration(vel, acc_raw - agk[:, None, :], h) + agk[:, None, :]
     else:  # exact propagators leave no period-2h residue; decimated samples are not smoothed
         acc = acc_raw
-    n_level = len(model.level_dofs)
-    force = level_sum(hist.friction, pallet_level, n_level)
+    planar = hist.planar
+    force = level_sum(with_direction(hist.friction, planar), model.pallet_level, ops.n_level)
     # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
     # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
     base_shear = hist.q @ ops.shear + ops.a1 * (hist.qd @ ops.shear)
     n_t = idx.shape[0]
-    mom_base = hist.q @ ops.base_moment
     shape = (n_t, ops.n_upright, ops.n_level)
-    conn = connection_moment((hist.q @ ops.below).reshape(shape),
-                             (hist.q @ ops.above).reshape(shape))
+    mom_base = per_dir(ops.base_moment, hist.q)
+    conn = np.stack([connection_moment((hist.q @ ops.below[d]).reshape(shape),
+                                       (hist.q @ ops.above[d]).reshape(shape))
+                     for d in range(nd)], axis=-1)
+    sq = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
+    lay = model.layout
     return RackResponse(
-        t=hist.t,
-        ground_accel=agk,
-        beam_displacement=disp,
-        beam_acceleration=acc,
-        beam_acceleration_raw=acc_raw,
-        contact_force=force,
-        base_shear=base_shear,
-        upright_moment_base=mom_base,
-        upright_moment_connection=conn,
-        pallet_sliding=hist.sliding,
-        pallet_friction=hist.friction,
-        pallet_level=pallet_level,
-        pallet_x=np.asarray(model.nodes[model.pallet_node, 0], dtype=float),
+        t=hist.t, ground_accel=sq(agk), beam_displacement=sq(disp), beam_acceleration=sq(acc),
+        beam_acceleration_raw=sq(acc_raw), contact_force=sq(force), base_shear=sq(base_shear),
+        upright_moment_base=sq(mom_base), upright_moment_connection=sq(conn),
+        pallet_sliding=hist.sliding, pallet_friction=hist.friction,
+        pallet_level=np.asarray(model.pallet_level), pallet_x=np.asarray(model.pallet_x),
         pallet_mass=np.asarray(model.pallet_mass, dtype=float),
         pallet_mu_static=np.asarray(model.pallet_mu_static, dtype=float),
         pallet_mu_dynamic=np.asarray(model.pallet_mu_dynamic, dtype=float),
-        pallet_limit_neg=np.asarray(model.pallet_limit_neg, dtype=float),
-        pallet_limit_pos=np.asarray(model.pallet_limit_pos, dtype=float),
-        events=hist.events,
-        energy=hist.energy,
-        g=float(model.g),
-        dt=h,
-        record_name=name,
-        status=hist.status,
-        history=hist,
-        rigid_beam_acceleration_peak=rigid_peak,
-        full_peaks=peaks,
-        pallet_bay=pallet_bays(model),
-        operators=ops,
+        pallet_limit_neg=np.asarray(lay.limit_neg), pallet_limit_pos=np.asarray(lay.limit_pos),
+        events=hist.events, energy=hist.energy, g=float(model.g), dt=h,
+        record_name=mot.name, status=hist.status, history=hist,
+        rigid_beam_acceleration_peak=rigid_peak, full_peaks=peaks,
+        pallet_bay=np.asarray(model.pallet_bay), operators=ops,
+        directions=model.directions, pallet_slot=np.asarray(model.pallet_slot),
+        vertical_accel=None if av is None else av[idx], angle_deg=mot.angle_deg,
+        level_y=np.asarray(model.level_y), fall_front=np.asarray(lay.fall_front),
+        fall_rear=np.asarray(lay.fall_rear), falls=tuple(contacts.falls()),
+        impacts=tuple(contacts.impacts()),
+        pallet_row=np.asarray(model.pallet_row) if model.n_rows > 1 else None,
     )

@@ -1,6 +1,10 @@
-"""The result of a rack time history: :class:`RackResponse` (arrays, peaks, summary).
+"""The result of a rack time history: :class:`RackResponse` (arrays, peaks, summary), one type
+for a 2D and a 3D rack.
 
 Built by :func:`seisrack.analysis.rack.run_rack`; never written back onto the model or spec.
+Per-direction quantities carry a trailing axis of the rack's horizontal directions where there
+are two (a 3D rack: down-aisle, cross-aisle); :meth:`RackResponse.directional` gives any of them
+with that axis whatever the dimension, which is what code meant for both dimensions reads.
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.analysis.pallet_contacts import Fall, Impact, describe_contact
 from seisrack.dynamics import Event, TimeHistory
 
 #: sliding below this [m] counts as "no sliding" (round-off of an exact zero)
@@ -21,36 +26,48 @@ SLIDING_TOL_M = 1e-6
 ACCEL_FILTER_HZ = 20.0
 #: order of the Butterworth low-pass, applied forward and backward (zero phase)
 ACCEL_FILTER_ORDER = 4
+#: the histories that have a direction (a trailing axis on a 3D rack)
+DIRECTIONAL = ("ground_accel", "beam_displacement", "beam_acceleration", "beam_acceleration_raw",
+               "beam_acceleration_filtered", "contact_force", "base_shear",
+               "upright_moment_base", "upright_moment_connection", "pallet_sliding",
+               "pallet_friction")
+#: JSON names of the directions
+_DIR_KEY = ("down_aisle", "cross_aisle")
 
 
 @dataclass(frozen=True)
 class RackResponse:
-    """Response of a rack to one ground motion. Motion is relative to the ground.
+    """Response of a rack to one ground motion. Motion is relative to the ground. ``[, d]``
+    marks the trailing direction axis of a 3D rack (d = 0 down-aisle, 1 cross-aisle).
 
-    t: (n_t,) [s]; ground_accel: (n_t,) [m/s²] (interpolated onto the analysis grid).
-    beam_displacement: (n_t, n_level) [m] mean horizontal displacement of each beam level.
-    beam_acceleration: (n_t, n_level) [m/s²] absolute horizontal acceleration of each level,
-        reported as the central difference of the beam velocity (see
-        :func:`smoothed_acceleration`); ``beam_acceleration_raw`` is the scheme's own value.
-    contact_force: (n_t, n_level) [N] total horizontal force of the beams on the pallets.
-    base_shear: (n_t,) [N] total horizontal support reaction (elastic + stiffness-proportional
-        damping forces), positive opposing positive ground displacement.
-    upright_moment_base: (n_t, n_upright) [N·m]; upright_moment_connection: (n_t, n_upright,
-        n_level) [N·m] largest-magnitude end moment of the upright segments at each connection.
-    pallet_sliding: (n_t, m) [m] each pallet relative to its beam; pallet_friction: (n_t, m) [N].
-
-    beam_acceleration_filtered: (n_t, n_level) [m/s²] the same, low-pass filtered at
-        ``acceleration_filter_hz`` (zero-phase Butterworth of the full-rate history; see
-        docs/theory/floor_acceleration.md), or None.
-    pallet_bay: (m,) 0-based bay of each pallet; pallets are identified by 1-based ids in
-        input order and labels ``L{level}-B{bay}-S{slot}`` (:meth:`pallet_labels`).
+    t: (n_t,) [s]; ground_accel: (n_t[, d]) [m/s²] (interpolated onto the analysis grid);
+    vertical_accel: (n_t,) or None.
+    beam_displacement: (n_t, n_level[, d]) [m] mean horizontal displacement of each beam level.
+    beam_acceleration: (n_t, n_level[, d]) [m/s²] absolute horizontal acceleration of each
+        level, reported as the central difference of the beam velocity (see
+        :func:`~seisrack.analysis.rack.smoothed_acceleration`); ``beam_acceleration_raw`` is
+        the scheme's own value; ``beam_acceleration_filtered`` the same low-pass filtered at
+        ``acceleration_filter_hz`` (zero-phase Butterworth of the full-rate history), or None.
+    contact_force: (n_t, n_level[, d]) [N] total horizontal force of the beams on the pallets.
+    base_shear: (n_t[, d]) [N] total horizontal support reaction (elastic + stiffness-
+        proportional damping forces), positive opposing positive ground displacement.
+    upright_moment_base: (n_t, n_upright[, d]) [N·m]; upright_moment_connection: (n_t,
+        n_upright, n_level[, d]) [N·m] largest-magnitude end moment of the upright segments at
+        each connection, in the bending plane of each direction (n_upright: the upright
+        columns, front and rear in 3D).
+    pallet_sliding: (n_t, m[, d]) [m] each pallet relative to its beam(s); pallet_friction:
+        (n_t, m[, d]) [N].
+    pallet_level, pallet_bay, pallet_slot: (m,) 0-based; pallets are identified by 1-based ids
+        in input order and labels ``L{level}-B{bay}-S{slot}`` (:meth:`pallet_labels`).
+    falls: first falls into an aisle (3D racks); impacts: first down-aisle contacts between
+        neighbouring pallets or with an upright (:mod:`seisrack.analysis.pallet_contacts`).
     operators: the projected recovery and design operators of the run
-        (:class:`~seisrack.analysis.peaks.RackOperators`), for :meth:`design_peaks` and
-        :func:`~seisrack.analysis.peaks.design_history`.
+        (:class:`~seisrack.analysis.peaks.RackOperators`).
 
     The histories hold the samples the run kept (``run_rack(save_every=...)``; ``t`` gives
-    their times). ``full_peaks`` holds the peaks over every analysis step (always computed);
-    the peak methods below read it, so decimating the histories never changes a peak.
+    their times). ``full_peaks`` holds the peaks over every analysis step (always computed,
+    with the direction axis); the peak methods below read it, so decimating the histories never
+    changes a peak.
     """
 
     t: np.ndarray
@@ -85,137 +102,206 @@ class RackResponse:
     acceleration_filter_hz: float = ACCEL_FILTER_HZ
     operators: Any = field(default=None, repr=False)
     hinges: Any = None  # HingeResponse (analysis.hinges) with nonlinear connections
+    directions: tuple[str, ...] = ("down-aisle",)
+    pallet_slot: np.ndarray | None = None
+    vertical_accel: np.ndarray | None = None
+    angle_deg: float = 0.0
+    level_y: np.ndarray | None = None
+    fall_front: np.ndarray | None = None
+    fall_rear: np.ndarray | None = None
+    falls: tuple[Fall, ...] = ()
+    impacts: tuple[Impact, ...] = ()
+    pallet_row: np.ndarray | None = None  # (m,) 0-based, back-to-back racks only
 
-    # ------------------------------------------------------------------ derived results
+    # ------------------------------------------------------------------ shapes
+    @property
+    def n_dir(self) -> int:
+        """Number of horizontal directions (1 for a 2D rack, 2 for a 3D rack)."""
+        return len(self.directions)
+
     @property
     def n_pallets(self) -> int:
         return int(self.pallet_mass.size)
 
+    def directional(self, name: str) -> np.ndarray | None:
+        """A history of :data:`DIRECTIONAL` (or a per-direction peak of ``full_peaks``) with
+        its trailing direction axis, whatever the rack's dimension."""
+        value = getattr(self, name)
+        if value is None or self.n_dir > 1:
+            return value
+        return np.asarray(value)[..., None]
+
+    def _squeeze(self, a: np.ndarray) -> np.ndarray:
+        """Drop the direction axis of a peak for a 2D rack (the shape its callers expect)."""
+        return a[..., 0] if self.n_dir == 1 else a
+
+    # ------------------------------------------------------------------ pallets
     def pallet_ids(self) -> list[int]:
         """1-based pallet ids in input order (the order of the rack file / ``[loading]``)."""
         return list(range(1, self.n_pallets + 1))
-
-    def pallet_slot(self) -> np.ndarray:
-        """(m,) 0-based position of each pallet within its (level, bay), left to right."""
-        bay = self._bay()
-        slot = np.zeros(self.n_pallets, dtype=int)
-        for j in range(self.n_pallets):
-            same = (self.pallet_level == self.pallet_level[j]) & (bay == bay[j])
-            slot[j] = int(np.sum(same & ((self.pallet_x < self.pallet_x[j]) | (
-                (self.pallet_x == self.pallet_x[j]) & (np.arange(self.n_pallets) < j)))))
-        return slot
 
     def _bay(self) -> np.ndarray:
         if self.pallet_bay is not None:
             return np.asarray(self.pallet_bay, dtype=int)
         return np.zeros(self.n_pallets, dtype=int)
 
+    def _slot(self) -> np.ndarray:
+        if self.pallet_slot is not None:
+            return np.asarray(self.pallet_slot, dtype=int)
+        return np.zeros(self.n_pallets, dtype=int)
+
     def pallet_labels(self) -> list[str]:
         """Readable label of each pallet, ``"L{level}-B{bay}-S{slot}"`` (all 1-based; slot =
-        position within the bay and level, left to right)."""
-        bay, slot = self._bay(), self.pallet_slot()
-        return [f"L{int(self.pallet_level[j]) + 1}-B{int(bay[j]) + 1}-S{int(slot[j]) + 1}"
-                for j in range(self.n_pallets)]
-
-    def pallet_peak_sliding(self) -> np.ndarray:
-        """(m,) [m] peak |sliding| of each pallet."""
-        if self.n_pallets == 0:
-            return np.zeros(0)
-        hi, lo = self._sliding_extremes()
-        return np.maximum(hi, -lo)
+        position within the bay and level, left to right), ``"R{row}-L…"`` on a back-to-back
+        rack (as :meth:`~seisrack.model.frame_model.FrameModel.pallet_labels`)."""
+        bay, slot = self._bay(), self._slot()
+        row = [""] * self.n_pallets if self.pallet_row is None else \
+            [f"R{int(r) + 1}-" for r in self.pallet_row]
+        return [f"{row[j]}L{int(self.pallet_level[j]) + 1}-B{int(bay[j]) + 1}-"
+                f"S{int(slot[j]) + 1}" for j in range(self.n_pallets)]
 
     def _sliding_extremes(self) -> tuple[np.ndarray, np.ndarray]:
-        """(m,), (m,) [m] largest and smallest sliding over every analysis step."""
+        """(m, n_dir), (m, n_dir) [m] largest and smallest sliding over every analysis step."""
         if self.full_peaks is not None:
             return self.full_peaks["sliding_max"], self.full_peaks["sliding_min"]
-        return np.max(self.pallet_sliding, axis=0), np.min(self.pallet_sliding, axis=0)
+        s = self.directional("pallet_sliding")
+        return np.max(s, axis=0), np.min(s, axis=0)
 
-    def pallet_residual(self) -> np.ndarray:
-        """(m,) [m] sliding at the end of the record."""
+    def pallet_peak_sliding(self) -> np.ndarray:
+        """(m,) [m] peak sliding of each pallet: its largest |sliding| on a 2D rack, the largest
+        magnitude of its sliding vector on a 3D rack."""
         if self.n_pallets == 0:
             return np.zeros(0)
+        if self.full_peaks is not None:
+            return np.asarray(self.full_peaks["sliding_magnitude"])
+        s = self.directional("pallet_sliding")
+        return np.sqrt((s * s).sum(axis=2)).max(axis=0)
+
+    def pallet_peak_sliding_by_direction(self) -> np.ndarray:
+        """(m, n_dir) [m] peak |sliding| of each pallet along each direction."""
+        hi, lo = self._sliding_extremes()
+        return np.maximum(hi, -lo) if self.n_pallets else np.zeros((0, self.n_dir))
+
+    def pallet_residual(self) -> np.ndarray:
+        """(m[, d]) [m] sliding at the end of the record."""
         return self.pallet_sliding[-1].copy()
 
     def fall_utilisation(self) -> np.ndarray:
-        """(m,) largest ratio of sliding to the free distance on the side it slid towards."""
+        """(m,) largest ratio of down-aisle sliding to the free distance on the side it slid
+        towards (1 or more: the pallet reached its neighbour or the upright)."""
         if self.n_pallets == 0:
             return np.zeros(0)
         hi, lo = self._sliding_extremes()
-        pos = hi.clip(0.0)
-        neg = (-lo).clip(0.0)
+        pos = hi[:, 0].clip(0.0)
+        neg = (-lo[:, 0]).clip(0.0)
         return np.maximum(_ratio(pos, self.pallet_limit_pos), _ratio(neg, self.pallet_limit_neg))
 
     def pallets_at_risk(self) -> list[int]:
-        """0-based indices of pallets whose sliding reached their free distance (may fall).
-
-        The summary (``summary()["pallets_at_risk"]``) lists the 1-based pallet ids instead."""
-        return [int(j) for j in np.flatnonzero(self.fall_utilisation() >= 1.0)]
+        """1-based ids of the pallets whose down-aisle sliding reached their free distance
+        (they hit a neighbour or an upright, or may fall), as every output numbers pallets."""
+        return [int(j) + 1 for j in np.flatnonzero(self.fall_utilisation() >= 1.0)]
 
     def sliding_occurred(self) -> bool:
         return bool(np.any(self.pallet_peak_sliding() > SLIDING_TOL_M))
 
+    # ------------------------------------------------------------------ checks and peaks
+    def _level_peak(self, name: str) -> np.ndarray:
+        """(n_level, n_dir) peak |value| of a per-level history over every analysis step."""
+        if self.full_peaks is not None:
+            return np.asarray(self.full_peaks[name])
+        return np.max(np.abs(self.directional(name)), axis=0)
+
+    def level_acceleration_magnitude(self) -> np.ndarray:
+        """(n_level,) [m/s²] peak magnitude of each level's absolute horizontal acceleration
+        (its only component on a 2D rack), over every analysis step."""
+        fp = self.full_peaks or {}
+        if "beam_acceleration_magnitude" in fp:
+            return np.asarray(fp["beam_acceleration_magnitude"])
+        a = self.directional("beam_acceleration")
+        return np.sqrt((a * a).sum(axis=2)).max(axis=0)
+
     def simplified_check(self) -> dict[str, Any]:
         """The paper's §II/§IV rule "no sliding if mu >= alpha" checked against this run.
 
-        alpha is the peak absolute beam acceleration over g of the level a pallet stands on,
-        taken from the companion run with rigidly held pallets (what a designer computes without
-        a sliding model), and also reported for this run.
+        alpha is the peak absolute horizontal acceleration (magnitude) over g of the level a
+        pallet stands on, from the companion run with rigidly held pallets: what a designer
+        computes without a sliding model. Without that run (``run_rack(rigid_companion=True)``,
+        ``seisrack run --rigid-check``) there is no verdict: this run's own accelerations, with
+        sliding pallets and the spikes of their stick–slip events, are not the designer's alpha
+        (the check would compare the rule against a different motion), so ``rule_safe`` is
+        None and ``alpha`` is this run's, labelled as such.
         """
-        alpha_run = self._level_peak("beam_acceleration") / self.g
-        alpha_rigid = (
-            self.rigid_beam_acceleration_peak / self.g
-            if self.rigid_beam_acceleration_peak is not None
-            else alpha_run
-        )
+        rigid = self.rigid_beam_acceleration_peak is not None
+        alpha_run = self.level_acceleration_magnitude() / self.g
+        alpha = np.asarray(self.rigid_beam_acceleration_peak) / self.g if rigid else alpha_run
         lv = self.pallet_level
-        predicted = self.pallet_mu_static < alpha_rigid[lv]
+        predicted = self.pallet_mu_static < alpha[lv]
         slid = self.pallet_peak_sliding() > SLIDING_TOL_M
         unsafe = slid & ~predicted
         return {
-            "rule": "no sliding if mu_static >= alpha = peak beam acceleration / g",
-            "alpha_source": "rigid companion run" if self.rigid_beam_acceleration_peak
-            is not None else "this run (run_rack(rigid_companion=True) for rigid pallets)",
-            "alpha_rigid": alpha_rigid.tolist(),
+            "rule": "no sliding if mu_static >= alpha = peak horizontal beam acceleration / g",
+            "alpha_source": "rigid companion run (pallets held)" if rigid else
+            "this run, with sliding pallets: not the designer's alpha; no verdict (run "
+            "run_rack(rigid_companion=True) or seisrack run --rigid-check)",
+            "assessed": rigid,
+            "alpha": alpha.tolist(),
+            "alpha_rigid": alpha.tolist() if rigid else None,
             "alpha_this_run": alpha_run.tolist(),
-            "predicted_sliding": predicted.tolist(),
+            "predicted_sliding": predicted.tolist() if rigid else None,
             "sliding": slid.tolist(),
-            "rule_safe": bool(not np.any(unsafe)),
-            "rule_conservative_by": (alpha_rigid[lv] - self.pallet_mu_static).tolist(),
+            "rule_safe": bool(not np.any(unsafe)) if rigid else None,
+            "rule_conservative_by": (alpha[lv] - self.pallet_mu_static).tolist()
+            if rigid else None,
         }
 
     def peaks(self) -> dict[str, Any]:
-        """Peak values (JSON-ready), the issue #5 ``--json`` schema plus extra fields."""
+        """Peak values (JSON-ready), the issue #5 ``--json`` schema plus extra fields. A scalar
+        is the largest over the levels, members and directions; ``per_direction`` gives each
+        direction's."""
         disp = self._level_peak("beam_displacement")
         acc = self._level_peak("beam_acceleration")
         force = self._level_peak("contact_force")
         fp = self.full_peaks
         if fp is not None:
-            mb, mc = fp["upright_moment_base"], fp["upright_moment_connection"]
-            total, shear = fp["total_friction_force"], fp["base_shear"]
+            mb, mc = np.asarray(fp["upright_moment_base"]), np.asarray(
+                fp["upright_moment_connection"])
+            total, shear = np.asarray(fp["total_friction_force"]), np.asarray(fp["base_shear"])
         else:
-            mb = np.max(np.abs(self.upright_moment_base))
-            conn = self.upright_moment_connection
-            mc = np.max(np.abs(conn)) if conn.size else 0.0
-            total = np.max(np.abs(self.contact_force.sum(axis=1)))
-            shear = np.max(np.abs(self.base_shear))
+            mb = np.abs(self.directional("upright_moment_base")).max(axis=(0, 1))
+            conn = self.directional("upright_moment_connection")
+            mc = np.abs(conn).max(axis=(0, 1, 2)) if conn.size else np.zeros(self.n_dir)
+            total = np.abs(self.directional("contact_force").sum(axis=1)).max(axis=0)
+            shear = np.abs(self.directional("base_shear")).max(axis=0)
         acc_f = self.filtered_level_peak()
         out = {
             "beam_displacement_m": float(disp.max()),
             "beam_acceleration_m_s2": float(acc.max()),
             "beam_acceleration_filtered_m_s2": None if acc_f is None else float(acc_f.max()),
             "acceleration_filter_hz": self.acceleration_filter_hz,
-            "total_friction_force_N": float(total),
-            "base_shear_N": float(shear),
-            "upright_moment_base_Nm": float(mb),
-            "upright_moment_connection_Nm": float(mc),
+            "total_friction_force_N": float(total.max()),
+            "base_shear_N": float(shear.max()),
+            "upright_moment_base_Nm": float(mb.max()),
+            "upright_moment_connection_Nm": float(mc.max()),
             "pallet_sliding_m": self.pallet_peak_sliding().tolist(),
             "pallet_residual_m": self.pallet_residual().tolist(),
             "per_level": {
-                "beam_displacement_m": disp.tolist(),
-                "beam_acceleration_m_s2": acc.tolist(),
-                "beam_acceleration_filtered_m_s2": None if acc_f is None else acc_f.tolist(),
-                "contact_force_N": force.tolist(),
+                "beam_displacement_m": self._squeeze(disp).tolist(),
+                "beam_acceleration_m_s2": self._squeeze(acc).tolist(),
+                "beam_acceleration_filtered_m_s2": None if acc_f is None
+                else self._squeeze(acc_f).tolist(),
+                "contact_force_N": self._squeeze(force).tolist(),
             },
+            "per_direction": {
+                _DIR_KEY[d]: {
+                    "beam_displacement_m": float(disp[:, d].max(initial=0.0)),
+                    "beam_acceleration_m_s2": float(acc[:, d].max(initial=0.0)),
+                    "base_shear_N": float(shear[d]),
+                    "total_friction_force_N": float(total[d]),
+                    "upright_moment_base_Nm": float(mb[d]),
+                    "upright_moment_connection_Nm": float(mc[d]),
+                    "pallet_sliding_max_m": float(self.pallet_peak_sliding_by_direction()[:, d]
+                                                  .max(initial=0.0)),
+                } for d in range(self.n_dir)},
         }
         design = self.design_peaks()
         if design is not None:
@@ -223,17 +309,21 @@ class RackResponse:
             for key in ("beam_end_moment_Nm", "beam_end_shear_N", "connector_moment_Nm",
                         "connector_rotation_rad", "upright_axial_force_N"):
                 out[key] = design[key]["max_abs"]
+            if "interstorey_drift_ratio_cross_aisle" in design:
+                out["interstorey_drift_ratio_cross_aisle"] = design[
+                    "interstorey_drift_ratio_cross_aisle"]["max_abs"]
         return out
 
     def filtered_level_peak(self) -> np.ndarray | None:
-        """(n_level,) [m/s²] peak of the low-pass filtered absolute level accelerations over
-        every analysis step (``acceleration_filter_hz``), or None when not available."""
+        """(n_level, n_dir) [m/s²] peak of the low-pass filtered absolute level accelerations
+        over every analysis step (``acceleration_filter_hz``), or None when not available."""
         fp = self.full_peaks or {}
         val = fp.get("beam_acceleration_filtered")
         return None if val is None else np.asarray(val)
 
     def design_peaks(self) -> dict[str, Any] | None:
-        """Design quantities per member and as peaks (see :func:`design_summary`)."""
+        """Design quantities per member and as peaks (see
+        :func:`~seisrack.analysis.peaks.design_summary`)."""
         from seisrack.analysis.hinges import nonlinear_connector_design
         from seisrack.analysis.peaks import design_summary
 
@@ -242,19 +332,48 @@ class RackResponse:
             nonlinear_connector_design(out, self.hinges)
         return out
 
-    def _level_peak(self, name: str) -> np.ndarray:
-        """(n_level,) peak |value| of a per-level history over every analysis step."""
-        if self.full_peaks is not None:
-            return np.asarray(self.full_peaks[name])
-        return np.max(np.abs(getattr(self, name)), axis=0)
+    # ------------------------------------------------------------------ summary
+    def pallet_rows(self) -> list[dict[str, Any]]:
+        """Per pallet (1-based id, label, level, bay, properties, peaks, limits, falls)."""
+        peak, residual, util = (self.pallet_peak_sliding(), self.pallet_residual(),
+                                self.fall_utilisation())
+        by_dir = self.pallet_peak_sliding_by_direction()
+        fall_at = {f.pallet: f for f in self.falls}
+        rows = []
+        for j, lab in enumerate(self.pallet_labels()):
+            row = {
+                "id": j + 1, "label": lab, "level": int(self.pallet_level[j]) + 1,
+                "bay": int(self._bay()[j]) + 1,
+                **({} if self.pallet_row is None else {"row": int(self.pallet_row[j]) + 1}),
+                "x_m": float(self.pallet_x[j]),
+                "mass_kg": float(self.pallet_mass[j]),
+                "mu_static": float(self.pallet_mu_static[j]),
+                "mu_dynamic": float(self.pallet_mu_dynamic[j]),
+                "peak_sliding_m": float(peak[j]),
+                "residual_m": np.asarray(residual[j]).tolist(),
+                "limit_neg_m": float(self.pallet_limit_neg[j]),
+                "limit_pos_m": float(self.pallet_limit_pos[j]),
+                "fall_utilisation": float(util[j]),
+                "sliding_phases": self.history.sliding_phases(j),
+            }
+            if self.n_dir > 1:
+                f = fall_at.get(j)
+                row.update({
+                    "peak_sliding_down_aisle_m": float(by_dir[j, 0]),
+                    "peak_sliding_cross_aisle_m": float(by_dir[j, 1]),
+                    "fall_limit_front_m": _num(self.fall_front[j]),
+                    "fall_limit_rear_m": _num(self.fall_rear[j]),
+                    "falls": None if f is None else {"time_s": f.time_s, "side": f.side},
+                })
+            rows.append(row)
+        return rows
 
     def summary(self) -> dict[str, Any]:
         """Everything the CLI prints with ``--json``."""
         n_slip = sum(1 for e in self.events if e.kind == "slip")
-        peak, residual, util = (
-            self.pallet_peak_sliding(), self.pallet_residual(), self.fall_utilisation()
-        )
-        return {
+        out = {
+            "dimension": "3D" if self.n_dir > 1 else "2D",
+            "directions": list(self.directions),
             "record": self.record_name,
             "g_m_s2": self.g,
             "dt_s": self.dt,
@@ -262,33 +381,44 @@ class RackResponse:
             "status": self.status,
             "peaks": self.peaks(),
             "sliding_occurred": self.sliding_occurred(),
-            "pallets_at_risk": [j + 1 for j in self.pallets_at_risk()],
-            "pallets": [
-                {
-                    "id": j + 1,
-                    "label": lab,
-                    "level": int(self.pallet_level[j]) + 1,
-                    "bay": int(self._bay()[j]) + 1,
-                    "x_m": float(self.pallet_x[j]),
-                    "mass_kg": float(self.pallet_mass[j]),
-                    "mu_static": float(self.pallet_mu_static[j]),
-                    "mu_dynamic": float(self.pallet_mu_dynamic[j]),
-                    "peak_sliding_m": float(peak[j]),
-                    "residual_m": float(residual[j]),
-                    "limit_neg_m": float(self.pallet_limit_neg[j]),
-                    "limit_pos_m": float(self.pallet_limit_pos[j]),
-                    "fall_utilisation": float(util[j]),
-                    "sliding_phases": self.history.sliding_phases(j),
-                }
-                for j, lab in enumerate(self.pallet_labels())
-            ],
+            "pallets_at_risk": self.pallets_at_risk(),
+            "pallets": self.pallet_rows(),
             "simplified_check": self.simplified_check(),
             "design": self.design_peaks(),
             "n_events": len(self.events),
             "n_slip_events": n_slip,
             "energy_balance_error": self.history.energy_error() if self.energy else None,
             "energy_J": {k: float(v[-1]) for k, v in self.energy.items()},
+            "impacts": [{"contact": describe_contact(i), "time_s": i.time_s,
+                         "closing_speed_m_s": i.speed_m_s} for i in self.impacts],
             **({} if self.hinges is None else {"hinges": self.hinge_summary()}),
+        }
+        if self.n_dir > 1:
+            out.update(self._falls_summary())
+        return out
+
+    def _falls_summary(self) -> dict[str, Any]:
+        levels = sorted({int(v) for v in self.pallet_level})
+        by_level = {str(lv + 1): sum(1 for f in self.falls if self.pallet_level[f.pallet] == lv)
+                    for lv in levels}
+        notes = []
+        if self.falls:
+            notes.append("the model keeps a fallen pallet on its beams: its peaks and residual "
+                         "after the fall time are not physical")
+        if self.impacts:
+            notes.append("impacts are first contacts; the pallets are not stopped by them in "
+                          "the model")
+        return {
+            "angle_deg": self.angle_deg,
+            "pallets_checked_for_falls": int(np.sum(np.isfinite(self.fall_front))),
+            "pallets_falling": len(self.falls),
+            "pallets_falling_into_aisle": sum(1 for f in self.falls if f.into_aisle),
+            "falls_by_level": by_level,
+            "falls": [{"pallet": f.pallet + 1, "label": self.pallet_labels()[f.pallet],
+                       "level": int(self.pallet_level[f.pallet]) + 1,
+                       "bay": int(self._bay()[f.pallet]) + 1, "time_s": f.time_s,
+                       "side": f.side} for f in self.falls],
+            "notes": notes,
         }
 
     def hinge_summary(self) -> dict[str, Any]:
@@ -306,6 +436,10 @@ class RackResponse:
             "hysteretic_energy_J": None if hyst is None else float(hyst[-1]),
             "hinges": rows,
         }
+
+
+def _num(x: float) -> float | None:
+    return None if not np.isfinite(float(x)) else float(x)
 
 
 def _ratio(demand: np.ndarray, limit: np.ndarray) -> np.ndarray:

@@ -2,12 +2,13 @@
 
     θ = P_tot · d_r / (V_tot · h)                                  (EN 1998-1 Eq. 4.28)
 
-per storey, with P_tot the total gravity load at and above the storey (members and pallets),
-d_r the peak interstorey drift of the time history (the mean horizontal displacement of the
-beam level above minus that below; no behaviour factor: the analysis is elastic), V_tot the peak
-storey shear (sum of the upright shears of the storey, from the element end forces of the kept
-history) and h the storey height. Verdicts, §4.4.2.2(2)-(4): θ ≤ 0.1 P-Δ may be neglected;
-0.1 < θ ≤ 0.2 amplify the seismic action effects by 1/(1-θ); θ ≤ 0.3 at most.
+per storey, with P_tot the total gravity load at and above the storey (members and pallets), d_r
+the peak interstorey drift of the time history (the mean horizontal displacement of the beam
+level above minus that below; no behaviour factor: the analysis is elastic), V_tot the peak
+storey shear (the net horizontal force the members and bars crossing the storey carry, over the
+kept history) and h the storey height; on a 3D rack in each horizontal direction. Verdicts,
+§4.4.2.2(2)-(4): θ ≤ 0.1 P-Δ may be neglected; 0.1 < θ ≤ 0.2 amplify the seismic action effects
+by 1/(1-θ); θ ≤ 0.3 at most.
 """
 
 from __future__ import annotations
@@ -17,12 +18,9 @@ from typing import Any
 import numpy as np
 
 from seisrack.checks.factors import CheckFactors
-from seisrack.fe.recovery import element_end_forces
 
 SOURCE = "EN 1998-1:2004"
 CLAUSE = "§4.4.2.2(2)-(4), Eq. (4.28)"
-#: kept samples per chunk when recovering upright shears (bounds memory for large racks)
-_CHUNK = 2000
 
 
 def theta_verdict(theta: float, f: CheckFactors) -> tuple[str, bool]:
@@ -61,54 +59,57 @@ def storey_gravity_loads(model: Any) -> np.ndarray:
     return np.array([float(model.g) * m[y > b + tol].sum() for b in bottoms])
 
 
-def storey_shear_history(model: Any, U: np.ndarray) -> np.ndarray:
-    """(n_t, n_storey) [N] sum of the upright shears of each storey (lowest segment per column).
+def storey_shear_history(model: Any, U: np.ndarray, direction: int = 0) -> np.ndarray:
+    """(n_t, n_storey) [N] storey shear along ``direction``: the elastic forces K u on the DOFs
+    of that direction above the bottom of each storey, i.e. the net horizontal force that the
+    members and bars crossing the storey carry (the uprights' shears on a plane frame, with the
+    bracing on a space frame; :func:`seisrack.design.operators.storey_operators`).
 
     U: (n_t, n_dof) [m, rad] displacements relative to the ground.
     """
-    kind = np.asarray(model.element_kind)
-    storey = np.asarray(model.element_storey)
-    line = np.asarray(model.element_line)
-    y0 = model.mesh.nodes[model.mesh.elements[:, 0], 1]
-    n_storey = len(model.level_dofs)
-    picks: list[np.ndarray] = []
-    for s in range(n_storey):
-        sel = []
-        for col in np.unique(line[kind == 0]):
-            cand = np.flatnonzero((kind == 0) & (storey == s) & (line == col))
-            if cand.size:
-                sel.append(cand[np.argmin(y0[cand])])
-        picks.append(np.array(sel, dtype=int))
-    out = np.empty((U.shape[0], n_storey))
-    for a in range(0, U.shape[0], _CHUNK):
-        f = element_end_forces(model, U[a:a + _CHUNK])  # (n, n_el, 6), local V_i = [..., 1]
-        for s, el in enumerate(picks):
-            out[a:a + _CHUNK, s] = f[:, el, 1].sum(axis=1)
-    return out
+    op = storey_shear_operator(model, direction)
+    return np.asarray(np.asarray(U) @ op)
+
+
+def storey_shear_operator(model: Any, direction: int = 0) -> Any:
+    """(n_dof, n_storey) sparse map from displacements to the storey shears along
+    ``direction`` (see :func:`storey_shear_history`)."""
+    from seisrack.design.operators import storey_operators
+
+    name = model.directions[direction]
+    return next(o.op for o in storey_operators(model, name)
+                if o.name.startswith("storey_shear"))
 
 
 def drift_sensitivity_check(model: Any, response: Any, factors: CheckFactors | None = None
                             ) -> dict[str, Any]:
-    """θ per storey from ``response`` (a RackResponse of ``model``); JSON-ready dict."""
+    """θ per storey and horizontal direction from ``response`` (a RackResponse of ``model``);
+    JSON-ready dict. The storey shear is projected onto the run's basis (never an
+    (n_t, n_dof) history)."""
     f = factors or CheckFactors()
     level_y = np.asarray(model.level_y, dtype=float)
     h = np.diff(np.concatenate([[0.0], level_y]))
-    disp = np.asarray(response.beam_displacement)  # (n_t, n_level)
-    rel = np.diff(np.concatenate([np.zeros((disp.shape[0], 1)), disp], axis=1), axis=1)
-    d_r = np.max(np.abs(rel), axis=0)
+    disp_all = response.directional("beam_displacement")  # (n_t, n_level, n_dir)
     P = storey_gravity_loads(model)
-    V = np.max(np.abs(storey_shear_history(model, np.asarray(response.history.u))), axis=0)
+    hist = response.history
     rows = []
     ok_all = True
-    for s in range(h.size):
-        theta = sensitivity_theta(P[s], d_r[s], V[s], h[s])
-        text, ok = theta_verdict(theta, f)
-        ok_all &= ok
-        rows.append({"storey": s + 1, "height_m": float(h[s]), "P_tot_N": float(P[s]),
-                     "drift_m": float(d_r[s]), "drift_ratio": float(d_r[s] / h[s]),
-                     "V_tot_N": float(V[s]), "theta": theta,
-                     "amplification": float(1.0 / (1.0 - theta)) if theta < 1 else None,
-                     "verdict": text, "ok": ok})
+    for d, name in enumerate(model.directions):
+        disp = disp_all[..., d]
+        rel = np.diff(np.concatenate([np.zeros((disp.shape[0], 1)), disp], axis=1), axis=1)
+        d_r = np.max(np.abs(rel), axis=0)
+        op = storey_shear_operator(model, d)
+        V = np.max(np.abs(hist.q @ np.asarray((op.T @ hist.phi).T)), axis=0)
+        for s in range(h.size):
+            theta = sensitivity_theta(P[s], d_r[s], V[s], h[s])
+            text, ok = theta_verdict(theta, f)
+            ok_all &= ok
+            rows.append({"storey": s + 1, "direction": name, "height_m": float(h[s]),
+                         "P_tot_N": float(P[s]), "drift_m": float(d_r[s]),
+                         "drift_ratio": float(d_r[s] / h[s]), "V_tot_N": float(V[s]),
+                         "theta": theta,
+                         "amplification": float(1.0 / (1.0 - theta)) if theta < 1 else None,
+                         "verdict": text, "ok": ok})
     worst = max(rows, key=lambda r: r["theta"]) if rows else None
     return {
         "name": "drift_sensitivity_ec8",
@@ -118,7 +119,7 @@ def drift_sensitivity_check(model: Any, response: Any, factors: CheckFactors | N
         "rule": "theta = P_tot d_r / (V_tot h); <= 0.1 neglect P-Delta, <= 0.2 amplify by "
                 "1/(1-theta), <= 0.3 second-order analysis, > 0.3 not allowed",
         "storeys": rows,
-        "verdict": (f"max θ = {worst['theta']:.3f} (storey {worst['storey']}): {worst['verdict']}"
-                    if worst else "no storeys"),
+        "verdict": (f"max θ = {worst['theta']:.3f} (storey {worst['storey']}, "
+                    f"{worst['direction']}): {worst['verdict']}" if worst else "no storeys"),
         "ok": bool(ok_all),
     }

@@ -12,7 +12,10 @@ clause text of EN 16681 itself was not available; see ``docs/user/design_checks.
 
 The level acceleration a_i is combined over the modes of the rack with rigidly held pallets
 (SRSS of Γ_k φ_k,i S_a(T_k), EN 1998-1 §4.3.3.3.2), with S_a from the given design spectrum or,
-without one, from the 5 %-damped response spectrum of the record.
+without one, from the 5 %-damped response spectrum of the record. On a 3D rack it is computed in
+each horizontal direction and the two are combined by SRSS (EN 1998-1 §4.3.3.5.1(2)b): friction
+is isotropic, so a pallet slides when the magnitude of the horizontal force on it exceeds
+γ_μS·μ_S·Q_P.
 """
 
 from __future__ import annotations
@@ -28,22 +31,29 @@ CLAUSE = ("prFEM 10.2.08 'Pallet sliding' (1)-(2) as published by Castiglioni (2
           "EN 16681 clause text not available here")
 
 
-def level_accelerations(model: Any, modal: Any, sa: np.ndarray) -> np.ndarray:
-    """(n_level,) [m/s²] SRSS peak absolute acceleration of each beam level.
+def level_accelerations(model: Any, modal: Any, sa: np.ndarray, direction: int = 0
+                        ) -> np.ndarray:
+    """(n_level,) [m/s²] SRSS peak absolute acceleration of each beam level along
+    ``direction`` (0 down-aisle, 1 cross-aisle) under a ground motion along it.
 
     modal: a ModalResult of ``model``; sa: (n_modes,) [m/s²] spectral acceleration S_a(T_k).
-    Eq: a_i = sqrt(Σ_k (Γ_k · φ̄_k,i · S_a(T_k))²), φ̄ the mean horizontal modal displacement of
-    the level's nodes (EN 1998-1 §4.3.3.3.2, SRSS).
+    Eq: a_i = sqrt(Σ_k (Γ_k · φ̄_k,i · S_a(T_k))²), φ̄ the mean modal displacement of the level's
+    nodes along the direction, Γ the participation factor of that direction (EN 1998-1
+    §4.3.3.3.2, SRSS).
     """
     sa = np.asarray(sa, dtype=float)
-    phi_lv = np.array([modal.shapes[np.asarray(d)].mean(axis=0) for d in model.level_dofs])
-    contrib = modal.gamma_x[None, :] * phi_lv * sa[None, :]  # (n_level, n_modes)
+    gamma = modal.gamma_x if direction == 0 else modal.gamma_z
+    phi_lv = np.array([modal.shapes[np.asarray(d)].mean(axis=0)
+                       for d in model.level_dofs[direction]])
+    contrib = gamma[None, :] * phi_lv * sa[None, :]  # (n_level, n_modes)
     return np.sqrt(np.sum(contrib**2, axis=1))
 
 
 def spectral_accelerations(modal: Any, *, spectrum: Any = None, record: Any = None,
-                           damping: float = 0.05) -> tuple[np.ndarray, str]:
-    """(n_modes,) [m/s²] S_a at the modal periods, and a description of where it came from."""
+                           damping: float = 0.05, direction: int = 0) -> tuple[np.ndarray, str]:
+    """(n_modes,) [m/s²] S_a at the modal periods, and a description of where it came from:
+    the design spectrum, else the response spectrum of the record (a Record, or the component
+    along ``direction`` of a GroundMotion; a missing component gives S_a = 0)."""
     periods = np.asarray(modal.periods, dtype=float)
     if spectrum is not None:
         return np.asarray(spectrum.psa(periods), dtype=float), \
@@ -52,9 +62,16 @@ def spectral_accelerations(modal: Any, *, spectrum: Any = None, record: Any = No
         raise ValueError("a design spectrum or a record is needed")
     from seisrack.motion import response_spectrum
 
-    sp = response_spectrum(record.accel, record.dt, periods, damping)
+    if hasattr(record, "horizontal"):  # a GroundMotion: its component along the direction
+        comps = record.horizontal
+        if direction >= len(comps):
+            return np.zeros_like(periods), f"no {('down', 'cross')[direction]}-aisle component"
+        accel, name = comps[direction], record.names[direction]
+    else:
+        accel, name = record.accel, record.name
+    sp = response_spectrum(accel, record.dt, periods, damping)
     return np.asarray(sp.psa, dtype=float), \
-        f"{100 * damping:g} %-damped response spectrum of record {record.name}"
+        f"{100 * damping:g} %-damped response spectrum of record {name}"
 
 
 def pallet_sliding_check(model: Any, modal: Any, *, spectrum: Any = None, record: Any = None,
@@ -65,9 +82,13 @@ def pallet_sliding_check(model: Any, modal: Any, *, spectrum: Any = None, record
     ``id``, level, μ used, a/g, verdicts), and ``sliding_predicted_uls`` per pallet.
     """
     f = factors or CheckFactors()
-    sa, sa_from = spectral_accelerations(modal, spectrum=spectrum, record=record,
-                                         damping=f.damping)
-    a_uls = f.e_d1_sliding * level_accelerations(model, modal, sa)
+    n_dir = len(model.level_dofs)
+    spectra = [spectral_accelerations(modal, spectrum=spectrum, record=record,
+                                      damping=f.damping, direction=d) for d in range(n_dir)]
+    sa_from = "; ".join(dict.fromkeys(how for _, how in spectra))
+    by_dir = np.array([f.e_d1_sliding * level_accelerations(model, modal, sa, d)
+                       for d, (sa, _) in enumerate(spectra)])  # (n_dir, n_level)
+    a_uls = np.sqrt(np.sum(by_dir**2, axis=0))  # the directions combined by SRSS
     a_sls = f.nu_sls * a_uls
     g = float(model.g)
     lv = pallet_levels(model)
@@ -96,7 +117,11 @@ def pallet_sliding_check(model: Any, modal: Any, *, spectrum: Any = None, record
         "clause": CLAUSE,
         "rule": "sliding if a_i/g > gamma_mu * mu (ULS: upper-bound mu, SLS: lower-bound mu)",
         "acceleration_from": sa_from,
-        "levels": [{"level": i + 1, "a_uls_m_s2": float(a_uls[i]), "a_sls_m_s2": float(a_sls[i])}
+        "directions": ("SRSS of the down-aisle and cross-aisle level accelerations "
+                       "(EN 1998-1 §4.3.3.5.1(2)b)" if n_dir > 1 else "down-aisle"),
+        "levels": [{"level": i + 1, "a_uls_m_s2": float(a_uls[i]), "a_sls_m_s2": float(a_sls[i]),
+                    **({"a_uls_down_aisle_m_s2": float(by_dir[0, i]),
+                        "a_uls_cross_aisle_m_s2": float(by_dir[1, i])} if n_dir > 1 else {})}
                    for i in range(a_uls.size)],
         "pallets": pallets,
         "verdict": (f"ULS: {n_u} of {len(pallets)} pallets predicted to slide "
@@ -108,6 +133,5 @@ def pallet_sliding_check(model: Any, modal: Any, *, spectrum: Any = None, record
 
 
 def pallet_levels(model: Any) -> np.ndarray:
-    """(n_pallet,) 0-based beam level of each pallet, from its horizontal DOF."""
-    where = {int(d): i for i, dofs in enumerate(model.level_dofs) for d in np.asarray(dofs)}
-    return np.array([where[int(d)] for d in model.pallet_dof], dtype=int)
+    """(n_pallet,) 0-based beam level of each pallet."""
+    return np.asarray(model.pallet_level, dtype=int)

@@ -15,7 +15,6 @@ import sys
 from collections.abc import Sequence
 
 from seisrack import __version__
-from seisrack.errors import SeisrackError
 
 _COMMAND_MODULES = (
     "seisrack.cli.modal",
@@ -27,6 +26,7 @@ _COMMAND_MODULES = (
     "seisrack.cli.study",
     "seisrack.cli.export",
     "seisrack.cli.report",
+    "seisrack.cli.design",
 )
 
 
@@ -69,45 +69,55 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; every failure becomes the one-paragraph error (see
+    :mod:`seisrack.cli._boundary`), and a closed output pipe ends the command quietly."""
     global _JSON_ERRORS
+    from seisrack.cli._boundary import quiet_broken_pipe
+
     _JSON_ERRORS = "--json" in (sys.argv[1:] if argv is None else list(argv))
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    logging.basicConfig(
-        level=logging.INFO if getattr(args, "verbose", False) else logging.WARNING,
-        format="%(levelname)s %(name)s: %(message)s",
-    )
-    func = getattr(args, "func", None)
-    if func is None:
-        parser.print_help(sys.stderr)
-        return 2
+    verbose = False
     try:
-        return int(func(args) or 0)
-    except SeisrackError as exc:
-        return _error(exc, str(exc))
-    except FileNotFoundError as exc:
-        return _error(exc, f"file not found: {exc.filename}", "file", exc.filename,
-                      "an existing file")
-    except IsADirectoryError as exc:
-        return _error(exc, f"expected a file, got a directory: {exc.filename}", "file",
-                      exc.filename, "a file")
-    except PermissionError as exc:
-        return _error(exc, f"permission denied: {exc.filename}", "file", exc.filename,
-                      "a readable/writable path")
-    except KeyboardInterrupt:
-        print("seisrack: interrupted", file=sys.stderr)
-        return 130
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        verbose = bool(getattr(args, "verbose", False))
+        logging.basicConfig(
+            level=logging.INFO if verbose else logging.WARNING,
+            format="%(levelname)s %(name)s: %(message)s",
+        )
+        func = getattr(args, "func", None)
+        if func is None:
+            parser.print_help(sys.stderr)
+            return 2
+        code = int(func(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, inside the boundary
+        return code
+    except BrokenPipeError:
+        quiet_broken_pipe()
+        return 0
+    except SystemExit:
+        raise  # argparse: --help, --version and usage errors (already reported)
+    except BaseException as exc:  # noqa: BLE001 - the one boundary: nothing escapes as a traceback
+        return _fail(exc, verbose)
 
 
-def _error(exc: BaseException, message: str, field: str | None = None, value: object = None,
-           allowed: str | None = None) -> int:
-    """Report a user error: one paragraph on stderr, or a JSON object on stdout with --json."""
-    if _JSON_ERRORS:
-        from seisrack.cli._common import error_object, print_json_error
+def _fail(exc: BaseException, verbose: bool) -> int:
+    """Report ``exc`` as one paragraph on stderr, or as the JSON object on stdout."""
+    from seisrack.cli._boundary import describe, quiet_broken_pipe, want_traceback
 
-        obj = (error_object(exc) if hasattr(exc, "field") else
-               error_object(message=message, field=field, value=value, allowed=allowed))
-        print_json_error(obj)
-    else:
-        print(f"seisrack: error: {message}", file=sys.stderr)
-    return 2
+    f = describe(exc)
+    if f.internal and want_traceback(verbose):
+        import traceback
+
+        traceback.print_exception(exc, file=sys.stderr)
+    try:
+        if _JSON_ERRORS:
+            from seisrack.cli._common import error_object, print_json_error
+
+            print_json_error(error_object(message=f.message, field=f.field, value=f.value,
+                                          allowed=f.allowed))
+            sys.stdout.flush()
+        else:
+            print(f"seisrack: error: {f.message}", file=sys.stderr)
+    except BrokenPipeError:
+        quiet_broken_pipe()
+    return f.code

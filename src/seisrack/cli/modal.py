@@ -22,92 +22,86 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.fe.modal import modal_analysis
+    from seisrack.limits import MAX_MODES, check_modes
     from seisrack.model import compile_rack, load_rack
+    from seisrack.progress import busy
 
-    if args.modes < 1:
-        raise InputError("--modes", args.modes, "an integer >= 1")
+    if not 1 <= args.modes <= MAX_MODES:
+        raise InputError("--modes", args.modes, f"an integer from 1 to {MAX_MODES:,}")
     spec = load_rack(args.rack)
-    model = compile_rack(spec)
-    res = modal_analysis(model, args.modes)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    check_modes(args.modes, model.n_dof)
+    with busy(f"modal analysis ({model.n_dof:,} DOFs, {args.modes} modes)"):
+        res = modal_analysis(model, args.modes)
     if args.plot:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
             raise InputError("--plot", args.plot, "a PNG path, with matplotlib installed",
                              hint="Install it with: pip install 'seisrack[plot]'") from None
-        if getattr(model, "is_3d", False):
-            from seisrack.report.frame_plot3d import save_modes_figure_3d as save_modes_figure
-        else:
-            from seisrack.report.frame_plot import save_modes_figure
+        from seisrack.report.frame_plot import save_modes_figure
 
         save_modes_figure(model, res, args.plot)
-    if getattr(model, "is_3d", False):
-        return _report_3d(args, spec, model, res)
-    cum = res.mass_participation.cumsum()
+    from seisrack.checks.plausibility import plausibility_warnings
+
+    warnings = plausibility_warnings(spec, model)
+    planar = model.r_z is not None  # a cross-aisle direction: z and plan-rotation terms
+    cx = res.mass_participation.cumsum()
     if args.json:
-        print_json({
+        out = {
             "rack": args.rack, "title": spec.title, "n_dof": model.n_dof,
+            "dimension": f"{model.ndm}D", "three_d": planar,
             "periods_s": res.periods, "frequencies_hz": res.frequencies,
             "mass_participation": res.mass_participation,
-            "cumulative_mass_participation": cum,
+            "cumulative_mass_participation": cx,
             "effective_mass_x_kg": res.effective_mass_x, "total_mass_x_kg": res.total_mass_x,
             "damping_coefficients": list(model.damping_coefficients),
             "critical_load_factor": model.critical_load_factor,
-            "plot": args.plot,
-        })
+            "plot": args.plot, "warnings": warnings,
+        }
+        if planar:
+            out.update({
+                "direction": list(res.direction),
+                "mass_participation_x": res.mass_participation,
+                "mass_participation_z": res.mass_participation_z,
+                "participation_theta": res.participation_theta,
+                "cumulative_mass_participation_z": res.mass_participation_z.cumsum(),
+                "effective_mass_z_kg": res.effective_mass_z,
+                "total_mass_z_kg": res.total_mass_z,
+                "effective_inertia_theta_kgm2": res.effective_inertia_theta,
+                "total_inertia_theta_kgm2": res.total_inertia_theta,
+                "plan_centre_m": list(model.plan_centre),
+            })
+        print_json(out)
         return 0
     print(f"{spec.title or args.rack}")
-    print(f"{model.n_dof} DOFs, horizontal mass {res.total_mass_x:.1f} kg "
-          "(pallets rigidly attached)")
+    plan = (f", plan inertia {res.total_inertia_theta:.1f} kg·m² about "
+            f"x = {model.plan_centre[0]:.3f} m, z = {model.plan_centre[1]:.3f} m"
+            if planar else "")
+    print(f"{model.ndm}D rack, {model.n_dof} DOFs, horizontal mass {res.total_mass_x:.1f} kg "
+          f"(pallets rigidly attached){plan}")
     if model.critical_load_factor is not None:
         print(f"P-Δ on ({spec.second_order.form} geometric stiffness of the gravity load): "
               f"critical load factor {model.critical_load_factor:.4g}")
-    print(f"{'mode':>4} {'period [s]':>11} {'freq [Hz]':>10} {'particip.':>10} {'cumul.':>8}")
+    head = f"{'mode':>4} {'period [s]':>11} {'freq [Hz]':>10} {'x-part.':>8} "
+    print(head + (f"{'z-part.':>8} {'θ-part.':>8} {'cum. x':>7} {'cum. z':>7}  direction"
+                  if planar else f"{'cum. x':>7}"))
+    cz = res.mass_participation_z.cumsum() if planar else None
     for k in range(res.n_modes):
-        print(f"{k + 1:>4} {res.periods[k]:>11.4f} {res.frequencies[k]:>10.3f} "
-              f"{100 * res.mass_participation[k]:>9.2f}% {100 * cum[k]:>7.2f}%")
+        row = (f"{k + 1:>4} {res.periods[k]:>11.4f} {res.frequencies[k]:>10.3f} "
+               f"{100 * res.mass_participation[k]:>7.2f}% ")
+        if planar:
+            row += (f"{100 * res.mass_participation_z[k]:>7.2f}% "
+                    f"{100 * res.participation_theta[k]:>7.2f}% {100 * cx[k]:>6.1f}% "
+                    f"{100 * cz[k]:>6.1f}%  {res.direction[k]}")
+        else:
+            row += f"{100 * cx[k]:>6.2f}%"
+        print(row)
     if args.plot:
         print(f"plot written to {args.plot}")
-    return 0
+    if warnings:
+        from seisrack.checks.plausibility import format_warnings
 
-
-def _report_3d(args: argparse.Namespace, spec: Any, model: Any, res: Any) -> int:
-    """Table or JSON of a 3D rack's modes: participation down-aisle (x), cross-aisle (z) and in
-    plan rotation (θ about the vertical through the plan mass centre), and each mode's class."""
-    from seisrack.cli._common import print_json
-
-    cx, cz = res.mass_participation.cumsum(), res.mass_participation_z.cumsum()
-    if args.json:
-        print_json({
-            "rack": args.rack, "title": spec.title, "n_dof": model.n_dof, "three_d": True,
-            "periods_s": res.periods, "frequencies_hz": res.frequencies,
-            "direction": list(res.direction),
-            "mass_participation": res.mass_participation,
-            "mass_participation_x": res.mass_participation,
-            "mass_participation_z": res.mass_participation_z,
-            "participation_theta": res.participation_theta,
-            "cumulative_mass_participation": cx, "cumulative_mass_participation_z": cz,
-            "effective_mass_x_kg": res.effective_mass_x, "total_mass_x_kg": res.total_mass_x,
-            "effective_mass_z_kg": res.effective_mass_z, "total_mass_z_kg": res.total_mass_z,
-            "effective_inertia_theta_kgm2": res.effective_inertia_theta,
-            "total_inertia_theta_kgm2": res.total_inertia_theta,
-            "plan_centre_m": list(model.plan_centre),
-            "damping_coefficients": list(model.damping_coefficients),
-            "plot": args.plot,
-        })
-        return 0
-    print(f"{spec.title or args.rack}")
-    print(f"3D rack, {model.n_dof} DOFs, horizontal mass {res.total_mass_x:.1f} kg (pallets "
-          f"rigidly attached), plan inertia {res.total_inertia_theta:.1f} kg·m² about "
-          f"x = {model.plan_centre[0]:.3f} m, z = {model.plan_centre[1]:.3f} m")
-    print(f"{'mode':>4} {'period [s]':>11} {'freq [Hz]':>10} {'x-part.':>8} {'z-part.':>8} "
-          f"{'θ-part.':>8} {'cum. x':>7} {'cum. z':>7}  direction")
-    for k in range(res.n_modes):
-        print(f"{k + 1:>4} {res.periods[k]:>11.4f} {res.frequencies[k]:>10.3f} "
-              f"{100 * res.mass_participation[k]:>7.2f}% "
-              f"{100 * res.mass_participation_z[k]:>7.2f}% "
-              f"{100 * res.participation_theta[k]:>7.2f}% {100 * cx[k]:>6.1f}% "
-              f"{100 * cz[k]:>6.1f}%  {res.direction[k]}")
-    if args.plot:
-        print(f"plot written to {args.plot}")
+        print(format_warnings(warnings).lstrip("\n"))
     return 0

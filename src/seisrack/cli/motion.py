@@ -9,6 +9,10 @@ from typing import Any
 
 from seisrack.cli._common import float_list, print_json
 
+#: most periods of one response spectrum: each costs a pass over the record; 10,000 periods
+#: resolve any spectrum far beyond plotting
+MAX_PERIODS = 10_000
+
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser("motion", help="ground motions: generate, spectrum, check")
@@ -74,10 +78,11 @@ def register(subparsers: Any) -> None:
 
 def _generate(args: argparse.Namespace) -> int:
     from seisrack.errors import InputError
+    from seisrack.limits import MAX_SUITE_COUNT
     from seisrack.motion import ec8_spectrum, generate_ec8_suite, write_record_csv
 
-    if args.count < 1:
-        raise InputError("--count", args.count, "an integer >= 1")
+    if not 1 <= args.count <= MAX_SUITE_COUNT:
+        raise InputError("--count", args.count, f"an integer from 1 to {MAX_SUITE_COUNT:,}")
     out = Path(args.out)
     single = args.count == 1 and out.suffix.lower() == ".csv"
     if single:
@@ -144,8 +149,12 @@ def _plot(record: Any, target: Any, damping: float, path: str) -> None:
 def _spectrum(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from seisrack.errors import InputError
     from seisrack.motion import read_record, response_spectrum
 
+    if args.periods and len(args.periods) > MAX_PERIODS:
+        raise InputError("--periods", f"{len(args.periods):,} periods",
+                         f"at most {MAX_PERIODS:,} periods")
     rec = read_record(args.file, units=args.units, dt=args.dt)
     T = np.asarray(args.periods) if args.periods else np.geomspace(0.02, 4.0, 100)
     sp = response_spectrum(rec.accel, rec.dt, T, args.damping)

@@ -19,12 +19,16 @@ from seisrack.cli.run_inputs import (  # noqa: F401  (re-exported: report.py, te
     _check_number,
     _input_warnings,
     _records,
+    ground_motion_from_args,
     output_folder,
+    register_motion_options,
     warn,
 )
 from seisrack.cli.run_text import format_report
+from seisrack.progress import busy
 
-#: runs with more analysis steps than this show a progress bar (when stderr is a terminal)
+#: runs with more analysis steps than this report their progress (a bar on a terminal, plain
+#: lines every few seconds otherwise: seisrack.progress)
 PROGRESS_MIN_STEPS = 20_000
 
 _OUT_HELP = (
@@ -45,24 +49,7 @@ def register(subparsers: Any) -> None:
                     "force, base shear, upright moments, and each pallet's sliding against its "
                     "fall limit (paper §IV). Units: SI (m, s, kg, N).")
     p.add_argument("rack", help="rack description (TOML)")
-    src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--motion", metavar="FILE",
-                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
-    src.add_argument("--builtin", metavar="NAME",
-                     help="a bundled record instead of --motion (e.g. elcentro_1940_ns)")
-    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2' (not needed for "
-                                   ".AT2 or seisrack CSV files)")
-    p.add_argument("--motion-dt", type=float, metavar="DT",
-                   help="[s] time step of a one-column record file")
-    p.add_argument("--motion-cross", metavar="FILE",
-                   help="3D racks: cross-aisle ground acceleration (the second horizontal "
-                        "component; same units, dt and length as --motion)")
-    p.add_argument("--angle", type=float, default=0.0, metavar="DEG",
-                   help="3D racks: incidence angle [deg] turning the horizontal pair from the "
-                        "down-aisle axis towards the cross-aisle one (default 0)")
-    p.add_argument("--vertical", metavar="FILE",
-                   help="vertical ground acceleration, same units, dt and length as the "
-                        "horizontal record (pallet normal forces become m (g + a_v))")
+    register_motion_options(p)
     p.add_argument("--mu", type=float, metavar="MU",
                    help="static friction coefficient of every pallet (overrides the file)")
     p.add_argument("--mu-dynamic", type=float, metavar="MUD",
@@ -170,36 +157,31 @@ def run(args: argparse.Namespace) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.model import compile_rack, load_rack, with_friction
+    from seisrack.model.features import require
 
     _check_options(args)
     spec = load_rack(args.rack)
     if args.mu is not None:
         spec = with_friction(spec, args.mu, args.mu_dynamic)
-    model = compile_rack(spec)
-    if getattr(model, "is_3d", False):
-        from seisrack.cli.run3d import run_3d
-
-        return run_3d(args, spec, model, _progress_bar)
-    from seisrack.cli.run3d import check_2d_options
-
-    check_2d_options(args)
-    rec, vert = _records(args)
-    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
-    _input_warnings(rec, vert, model.g, scaling is not None)
+    with busy(f"building the rack ({args.rack})"):
+        model = compile_rack(spec)
+    if args.method == "exact" and model.n_dir > 1:
+        require("exact modal propagators (method exact)", model.ndm, "--method", args.method)
+    motion, scaling = ground_motion_from_args(args, model)
+    check_run_size(args, model, motion)  # before the run allocates anything
     try:
-        k = analysis_grid(rec, args.dt)
+        k = analysis_grid(motion, args.dt)
     except InputError as exc:
         raise InputError("--dt", args.dt, exc.allowed) from None
     from seisrack.report.rack_plot import existing_figures
 
     plot, out = output_folder(args, existing_figures)
-    n_pad = int(round(args.free_vibration / rec.dt))
-    n_steps = (rec.n - 1 + n_pad) * k
+    n_pad = int(round(args.free_vibration / motion.dt))
+    n_steps = (motion.n - 1 + n_pad) * k
     bar = _progress_bar(n_steps)
     try:
-        resp = run_rack(model, rec, dt=rec.dt / k, vertical=vert,
-                        free_vibration=args.free_vibration, method=args.method,
-                        basis=args.basis, save_every=args.save_every,
+        resp = run_rack(model, motion, dt=motion.dt / k, free_vibration=args.free_vibration,
+                        method=args.method, basis=args.basis, save_every=args.save_every,
                         rigid_companion=args.rigid_check,
                         progress=None if bar is None else bar.update,
                         **({} if args.accel_filter is None
@@ -209,31 +191,54 @@ def run(args: argparse.Namespace) -> int:
             bar.close()
 
     _result_warnings(resp, model)
-    summary = resp.summary()
-    summary = {"rack": args.rack, "title": spec.title, **summary,
+    summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
                "integration": resp.history.method, "basis": resp.history.basis}
+    if resp.history.work:
+        summary["work"] = resp.history.work
     if scaling is not None:
         scaling["run_ground_pga_m_s2"] = float(np.max(np.abs(resp.ground_accel)))
         summary["scaling"] = scaling
+    from seisrack.checks.plausibility import format_warnings, plausibility_warnings
+
+    summary["warnings"] = plausibility_warnings(spec, model, summary)
     if out is not None:
         _write_outputs(resp, model, spec, summary, out, plot, args.force)  # adds "outputs"
     if args.json:
         print_json(summary)
     else:
-        print(format_report(resp, spec, rec, vert, summary))
+        print(format_report(resp, spec, motion, summary) + format_warnings(summary["warnings"]))
     return 0
 
 
 def _progress_bar(n_steps: int) -> Any:
-    """A tqdm bar on stderr for long runs written to a terminal, else None."""
-    if n_steps <= PROGRESS_MIN_STEPS or not sys.stderr.isatty():
+    """Progress of a long run on stderr (:func:`seisrack.progress.progress`: a tqdm bar on a
+    terminal, a plain line every few seconds otherwise), or None for a short one."""
+    if n_steps <= PROGRESS_MIN_STEPS:
         return None
+    from seisrack.progress import progress
+
+    return progress(n_steps, "time history", "step")
+
+
+def check_run_size(args: argparse.Namespace, model: Any, motion: Any) -> None:
+    """Estimate the run's memory and time from the ground motion's length and the rack, and
+    refuse it up front when out of reach (:mod:`seisrack.limits`); announce a long one."""
+    from seisrack.analysis import analysis_grid
+    from seisrack.errors import InputError
+    from seisrack.limits import ANNOUNCE_S, check_run, estimate_run
+
     try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=n_steps, unit="step", desc="time history", file=sys.stderr,
-                leave=False, dynamic_ncols=True)
+        k = analysis_grid(motion, args.dt)
+    except InputError:
+        return  # the run reports the bad --dt itself
+    n_pad = int(round(args.free_vibration / motion.dt))
+    est = estimate_run(n_record=motion.n, k=k, n_pad=n_pad, n_dof=model.n_dof,
+                       n_pallets=model.n_pallets, n_levels=max(1, len(model.level_y)),
+                       save_every=args.save_every, vertical=motion.v is not None,
+                       three_d=model.ndm == 3)
+    check_run(est, n_record=motion.n, n_pad=n_pad, save_every=args.save_every)
+    if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:
+        print(f"seisrack: estimated: {est.describe()} (one core)", file=sys.stderr)
 
 
 def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], out: Path,
@@ -249,8 +254,8 @@ def _write_outputs(resp: Any, model: Any, spec: Any, summary: dict[str, Any], ou
     if plot:
         from seisrack.report.rack_plot import save_rack_figures
 
-        written += save_rack_figures(resp, out, suptitle=f"{title} - {resp.record_name}",
-                                     force=force)
+        written += save_rack_figures(resp, out, model=model,
+                                     suptitle=f"{title} - {resp.record_name}", force=force)
     summary_path = out / rack_io.SUMMARY_FILE
     written.append(summary_path)
     summary["outputs"] = [str(p) for p in written]

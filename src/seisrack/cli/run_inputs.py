@@ -191,3 +191,53 @@ def _input_warnings(rec: Any, vert: Any, g: float, scaled: bool) -> None:
             warn(f"the vertical acceleration reaches {low:.3g} m/s², below -g = {-g:.3g} "
                  "m/s²: the pallets would lift off; the model clips their normal force at 0 "
                  "and does not follow them in the air")
+
+
+# ------------------------------------------------------------------------------ the motion
+def register_motion_options(p: argparse.ArgumentParser) -> None:
+    """The ground-motion options of ``seisrack run`` and ``seisrack report``."""
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument("--motion", metavar="FILE",
+                     help="horizontal ground acceleration: PEER .AT2, or 1-/2-column text/CSV")
+    src.add_argument("--builtin", metavar="NAME",
+                     help="a bundled record instead of --motion (e.g. elcentro_1940_ns)")
+    p.add_argument("--units", help="units of the record file: 'g' or 'm/s2' (not needed for "
+                                   ".AT2 or seisrack CSV files)")
+    p.add_argument("--motion-dt", type=float, metavar="DT",
+                   help="[s] time step of a one-column record file")
+    p.add_argument("--motion-cross", metavar="FILE",
+                   help="3D racks: cross-aisle ground acceleration (the second horizontal "
+                        "component; same units, dt and length as --motion)")
+    p.add_argument("--angle", type=float, default=0.0, metavar="DEG",
+                   help="3D racks: incidence angle [deg] turning the horizontal pair from the "
+                        "down-aisle axis towards the cross-aisle one (default 0)")
+    p.add_argument("--vertical", metavar="FILE",
+                   help="vertical ground acceleration, same units, dt and length as the "
+                        "horizontal record (pallet normal forces become m (g + a_v))")
+
+
+def ground_motion_from_args(args: argparse.Namespace, model: Any
+                            ) -> tuple[Any, dict[str, Any] | None]:
+    """The ground motion the options describe, scaled as asked: (GroundMotion, scaling)."""
+    from seisrack.errors import InputError
+    from seisrack.model.features import require
+    from seisrack.motion import scale_by
+    from seisrack.motion.components import combine
+
+    if args.motion_cross is not None:
+        require("a cross-aisle ground motion component", model.ndm, "--motion-cross",
+                args.motion_cross)
+    if args.angle:
+        require("an incidence angle of the horizontal components", model.ndm, "--angle",
+                args.angle)
+    if not (math.isfinite(args.angle) and -360.0 <= args.angle <= 360.0):
+        raise InputError("--angle", args.angle, "an incidence angle in degrees, -360 to 360")
+    rec, vert = _records(args)
+    cross = None if args.motion_cross is None else _read(args.motion_cross, "--motion-cross",
+                                                          args)
+    rec, vert, scaling = _apply_scaling(args, model, rec, vert)
+    if cross is not None and scaling is not None:
+        cross = scale_by(cross, scaling["factor"])
+    _input_warnings(rec, vert, model.g, scaling is not None)
+    return combine(rec, cross, vert, args.angle,
+                   fields=("--motion", "--motion-cross", "--vertical")), scaling

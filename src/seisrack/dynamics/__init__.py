@@ -2,6 +2,6 @@
 
 from seisrack.dynamics.engine import modal_basis, simulate
 from seisrack.dynamics.results import Event, TimeHistory
-from seisrack.dynamics.sliders import Sliders
+from seisrack.dynamics.sliders import PlanarSliders, Sliders
 
-__all__ = ["Event", "Sliders", "TimeHistory", "modal_basis", "simulate"]
+__all__ = ["Event", "PlanarSliders", "Sliders", "TimeHistory", "modal_basis", "simulate"]

@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from seisrack.dynamics.basis import Basis, full_basis, reduced_basis
+from seisrack.dynamics.basis import Basis, full_basis
 from seisrack.dynamics.sliders import Sliders
 from seisrack.errors import InputError
 
@@ -40,31 +40,6 @@ def given_or_full_basis(basis, M, K) -> Basis | None:  # noqa: ANN001, N803
     if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
         return full_basis(M, K)
     return None
-
-
-def _choose_basis(basis, M, K, sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN001, N803
-    n = M.shape[0]
-    chosen = given_or_full_basis(basis, M, K)
-    if chosen is not None:
-        return chosen
-    on = sliders.dof >= 0
-    extra = np.zeros(n)
-    np.add.at(extra, sliders.dof[on], sliders.mass[on])
-    loads = [M @ r + extra * r]
-    if rv is not None:
-        loads.append(M @ rv)
-    if F is not None:
-        loaded = np.flatnonzero(np.any(F != 0.0, axis=0))
-        if loaded.size <= 10:
-            for d in loaded:
-                e = np.zeros(n)
-                e[d] = 1.0
-                loads.append(e)
-    if hinges.nonlinear:
-        loads.append(hinges.load_vectors(n)[:, hinges.law != 0])
-        return reduced_basis(M, K, sliders.dof, sliders.mass, np.column_stack(loads),
-                             blocks=HINGE_RITZ_BLOCKS, tol=HINGE_RITZ_TOL)
-    return reduced_basis(M, K, sliders.dof, sliders.mass, np.column_stack(loads))
 
 
 def _kept_samples(n_steps: int, save_every: int | None) -> int:

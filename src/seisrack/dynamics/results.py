@@ -25,10 +25,16 @@ class TimeHistory:
 
     t: (n_t,) [s]; u, v, a: (n_t, n_dof) [m, m/s, m/s²] structural DOFs, computed on first
     access from the modal coordinates ``q, qd, qdd`` and the mass-normalised basis ``phi``
-    (``u = q @ phi.T``); use :meth:`dof_response` for a few DOFs only;
-    slider_u, slider_v: (n_t, m) slider displacement / velocity [m, m/s];
-    sliding: (n_t, m) [m] slider displacement relative to its support node;
-    friction: (n_t, m) [N] horizontal force of the structure on each slider;
+    (``u = q @ phi.T``); use :meth:`dof_response` for a few DOFs only.
+    Sliders moving along one line (:class:`~seisrack.dynamics.Sliders`) have one value per
+    slider, sliders moving in the plane (:class:`~seisrack.dynamics.PlanarSliders`) a
+    trailing axis of two components (x, z): the shapes below are ``(n_t, m)`` or
+    ``(n_t, m, 2)``.
+    slider_u, slider_v: slider displacement / velocity relative to the ground [m, m/s]
+    (sliders on a line; None in the plane);
+    sliding: [m] slider displacement relative to its support; sliding_v: [m/s] its velocity
+    (stored by the planar scheme, else :attr:`sliding_velocity` computes it);
+    friction: [N] horizontal force of the structure on each slider;
     normal: (n_t, m) [N] normal force; stuck: (n_t, m) bool;
     energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction, and with
     nonlinear hinges "hysteresis" (their dissipated work; "strain" is then the recoverable part);
@@ -43,8 +49,8 @@ class TimeHistory:
     qd: np.ndarray
     qdd: np.ndarray
     phi: np.ndarray
-    slider_u: np.ndarray
-    slider_v: np.ndarray
+    slider_u: np.ndarray | None
+    slider_v: np.ndarray | None
     sliding: np.ndarray
     friction: np.ndarray
     normal: np.ndarray
@@ -62,6 +68,13 @@ class TimeHistory:
     hinge_moment: np.ndarray | None = None
     hinge_operator: np.ndarray | None = None
     hinge_rotation0: np.ndarray | None = None
+    sliding_v: np.ndarray | None = None
+    work: dict = field(default_factory=dict)
+
+    @property
+    def planar(self) -> bool:
+        """True for sliders moving in the plane (a trailing axis of 2 components)."""
+        return self.sliding.ndim == 3
 
     @property
     def hinge_rotation(self) -> np.ndarray | None:
@@ -91,7 +104,9 @@ class TimeHistory:
 
     @property
     def sliding_velocity(self) -> np.ndarray:
-        """(n_t, m) [m/s] slider velocity relative to its support node."""
+        """[m/s] slider velocity relative to its support, the shape of :attr:`sliding`."""
+        if self.sliding_v is not None:
+            return self.sliding_v
         support = np.zeros_like(self.slider_v)
         on = self.slider_dof >= 0
         support[:, on] = self.dof_response(self.slider_dof[on], "v")
@@ -106,7 +121,8 @@ class TimeHistory:
         )
 
     def energy_error(self) -> float:
-        """Relative residual of input = kinetic + strain + damping + friction (from t = 0)."""
+        """Relative residual of input = kinetic + strain + damping + friction (from t = 0); nan
+        when the run tracked no energy."""
         if not self.energy:
             return float("nan")
         e = self.energy

@@ -1,4 +1,5 @@
-"""Specification of the masses that rest on the structure with Coulomb friction."""
+"""The masses that rest on the structure with Coulomb friction: :class:`Sliders` move along one
+line (2D racks), :class:`PlanarSliders` in the horizontal plane (3D racks)."""
 
 from __future__ import annotations
 
@@ -77,6 +78,92 @@ class Sliders:
     def count(self) -> int:
         return int(self.dof.size)
 
+    def check_dofs(self, n: int) -> None:
+        """InputError unless every DOF index is in [0, n - 1] or -1 (the ground)."""
+        bad = self.dof[(self.dof < -1) | (self.dof >= n)]
+        if bad.size:
+            raise InputError("sliders.dof", bad.tolist(),
+                             f"DOF indices in [0, {n - 1}], or -1 (rests on the ground)")
+
     @property
     def velocity_dependent(self) -> bool:
         return bool(np.any((self.friction_rate > 0) & (self.mu_static > self.mu_dynamic)))
+
+
+@dataclass(frozen=True)
+class PlanarSliders:
+    """Pallets resting on structural nodes, free to slide in the horizontal plane.
+
+    dof_x, dof_z: (m, k) int, the x (down-aisle) and z (cross-aisle) translation DOFs of the
+        ``k`` points each pallet rests on (-1: the ground, a rigid support moving with it); the
+        pallet's support motion is their mean and its friction force is shared equally.
+    mass [kg], mu_static, mu_dynamic (0 <= mu_d <= mu_s): (m,) or scalars.
+    """
+
+    dof_x: np.ndarray
+    dof_z: np.ndarray
+    mass: np.ndarray
+    mu_static: np.ndarray
+    mu_dynamic: np.ndarray
+
+    def __init__(self, dof_x, dof_z, mass, mu_static, mu_dynamic=None) -> None:  # noqa: ANN001
+        dx = np.asarray(dof_x)
+        dz = np.asarray(dof_z)
+        if dx.ndim == 1:
+            dx = dx[:, None]
+        if dz.ndim == 1:
+            dz = dz[:, None]
+        if dx.ndim != 2 or dx.shape != dz.shape:
+            raise InputError("sliders.dof_z", f"shape {dz.shape}",
+                             f"the shape of dof_x {dx.shape}: (pallets, supports)")
+        for name, a in (("dof_x", dx), ("dof_z", dz)):
+            if a.size and not np.all(np.equal(np.mod(a, 1), 0)):
+                raise InputError(f"sliders.{name}", a.tolist(), "integer DOF indices")
+        m = dx.shape[0]
+
+        def _arr(name: str, val) -> np.ndarray:  # noqa: ANN001
+            a = np.asarray(val, dtype=float)
+            if a.ndim == 0:
+                a = np.full(m, float(a))
+            if a.shape != (m,) or not np.all(np.isfinite(a)):
+                raise InputError(f"sliders.{name}", val, f"a finite scalar or {m} values")
+            return a
+
+        mass_a = _arr("mass", mass)
+        mus = _arr("mu_static", mu_static)
+        mud = mus.copy() if mu_dynamic is None else _arr("mu_dynamic", mu_dynamic)
+        if np.any(mass_a <= 0):
+            raise InputError("sliders.mass", mass_a.tolist(), "masses > 0 kg")
+        if np.any(mus < 0) or np.any(mud < 0):
+            raise InputError("sliders.mu", [mus.tolist(), mud.tolist()],
+                             "friction coefficients >= 0")
+        if np.any(mud > mus):
+            j = int(np.argmax(mud > mus))
+            raise InputError(f"sliders.mu_dynamic[{j}]", float(mud[j]),
+                             f"a value <= mu_static ({mus[j]:g})")
+        object.__setattr__(self, "dof_x", dx.astype(np.int64))
+        object.__setattr__(self, "dof_z", dz.astype(np.int64))
+        object.__setattr__(self, "mass", mass_a)
+        object.__setattr__(self, "mu_static", mus)
+        object.__setattr__(self, "mu_dynamic", mud)
+
+    @property
+    def count(self) -> int:
+        return int(self.mass.shape[0])
+
+    def check_dofs(self, n: int) -> None:
+        """InputError unless every DOF index is in [0, n - 1] or -1 (the ground)."""
+        for name, d in (("dof_x", self.dof_x), ("dof_z", self.dof_z)):
+            if np.any(d < -1) or np.any(d >= n):
+                raise InputError(f"sliders.{name}", d[(d < -1) | (d >= n)].tolist(),
+                                 f"DOF indices in [0, {n - 1}] or -1 (the ground)")
+
+    def support_matrix(self, phi: np.ndarray) -> np.ndarray:
+        """(2m, r): rows 2p (x) and 2p+1 (z) give pallet p's support motion from ``q``."""
+        m, k = self.dof_x.shape
+        P = np.zeros((2 * m, phi.shape[1]))
+        for c, dofs in enumerate((self.dof_x, self.dof_z)):
+            for s in range(k):
+                on = dofs[:, s] >= 0
+                P[2 * np.flatnonzero(on) + c] += phi[dofs[on, s], :] / k
+        return P

@@ -1,17 +1,25 @@
 """Export a compiled rack as a standalone OpenSeesPy script: :func:`opensees_script`.
 
 The script rebuilds the :class:`~seisrack.model.FrameModel` node for node from ``model.mesh``
-and the pallet arrays (never from the assembled K, M, C), with the mapping of
-``benchmarks/opensees_rack.py`` (which now builds its peer model by executing this script):
+and the pallet arrays (never from the assembled K, M, C), whatever the rack's dimension (the
+tables: :mod:`seisrack.export._opensees_tables`; the functions:
+:mod:`seisrack.export._opensees_template`; ``benchmarks/opensees_rack.py`` builds its 2D peer
+model by executing this script):
 
-- every mesh node is an OpenSees node (``ndm=2, ndf=3``); nodes sharing DOF indices in
-  ``mesh.node_dofs`` (a semi-rigid beam end shares ux, uy with its upright node) are tied by
-  ``equalDOF`` to the first node holding the DOF;
-- every member is a ``dispBeamColumn`` with an ``Elastic`` section, 3-point Gauss-Legendre
+- every mesh node is an OpenSees node (``ndm 2, ndf 3`` or ``ndm 3, ndf 6``); nodes sharing
+  DOF indices in ``mesh.node_dofs`` (a semi-rigid beam end shares the translations, and in 3D
+  the rotations rx, ry, with its upright node) are tied by ``equalDOF`` to the first node
+  holding the DOF;
+- a plane member is a ``dispBeamColumn`` with an ``Elastic`` section, 3-point Gauss-Legendre
   integration, a ``Linear`` transformation and consistent mass: for a prismatic elastic member
   exactly seisrack's cubic-Hermite / linear-axial element. Not ``elasticBeamColumn``: in
-  OpenSeesPy 3.7.1 its element mass takes the ground-motion load twice under
-  ``UniformExcitation`` (measured in ``benchmarks/opensees_rack.py``);
+  OpenSeesPy 3.7.1 its 2D element mass takes the ground-motion load twice under
+  ``UniformExcitation`` (measured in ``benchmarks/opensees_rack.py``). A space member is an
+  ``elasticBeamColumn`` (3D, consistent mass, ``Linear`` transformation with the member's
+  ``vecxz``), written with J' = Ip and G' = G J / Ip so that its twist stiffness and inertia are
+  seisrack's (OpenSees 3.7 takes the torsional inertia from J); its 3D mass is loaded once
+  (measured against ``dispBeamColumn``, which has no twist inertia). Bracing bars are
+  ``Truss`` elements with consistent mass;
 - every spring of ``mesh.springs`` is a ``zeroLength`` with an ``Elastic`` material, to a
   fixed extra node for a spring to the ground, with ``-doRayleigh 1``. When the rack's
   ``[hysteresis]`` gives the connections a nonlinear law (``hysteresis=spec.hysteresis``), each
@@ -21,10 +29,18 @@ and the pallet arrays (never from the assembled K, M, C), with the mapping of
   u_j − u_i is seisrack's hinge rotation u[a] − u[b] (``model.hinge_dofs = (a, b)``: beam end
   minus upright for a connector, base rotation for a base plate): an asymmetric law acts with
   the same sign in both programs;
-- a pallet's vertical mass is nodal mass on its beam node's uy; its horizontal mass sits on its
-  own node (uy, rz fixed), joined to the beam node by an ``ElasticPP`` zeroLength (yield force
-  mu m g, initial stiffness ``k_init``: a regularised Coulomb law with mu_s = mu_d) or, with
-  ``pallets="rigid"``, by ``equalDOF`` in ux;
+- 2D pallets: the vertical mass is nodal mass on the beam node's uy; the horizontal mass sits
+  on the pallet's own node (uy, rz fixed), joined to the beam node by an ``ElasticPP``
+  zeroLength (yield force mu m g, initial stiffness ``k_init``: a regularised Coulomb law with
+  mu_s = mu_d) or, with ``pallets="rigid"``, by ``equalDOF`` in ux. 3D pallets: the mass is
+  shared equally by the supports (front and rear beam node); ``rigid``: nodal masses there
+  (seisrack's modal model); ``friction``: one own node per support on a
+  ``flatSliderBearing`` with a ``Coulomb`` friction model (circular friction, normal force
+  from gravity, the regularised peer of seisrack's planar sliders), the own nodes of a pallet
+  tied in x and z;
+- gravity (``gravity()``, before any time history): the members' and bars' weight as their
+  consistent nodal loads (seisrack's −g·M·r_y, computed by the script from its tables), and
+  the pallets' weights where their vertical masses are;
 - damping C = a0 M + a1 K_initial, ``rayleigh(0, 0, a1, 0)`` (initial stiffness, as
   seisrack's C; the same as the current one for a linear rack) or, when a0 != 0, by regions
   (nodes, then elements), so that the pallets' horizontal masses and friction elements are
@@ -42,8 +58,9 @@ from typing import Any
 
 import numpy as np
 
-from seisrack import __version__
 from seisrack.errors import InputError
+from seisrack.export._opensees_header import header
+from seisrack.export._opensees_tables import script_tables
 from seisrack.export._opensees_template import FUNCTIONS
 
 log = logging.getLogger(__name__)
@@ -51,6 +68,9 @@ log = logging.getLogger(__name__)
 PALLET_MODES = ("friction", "rigid")
 #: racks with at most this many DOFs use a dense eigen solver and a banded system
 DENSE_MAX_DOF = 500
+#: [N/m] axial stiffness of the 3D friction bearings (rigid against the beams' vertical
+#: stiffness, ~1e6 N/m; its vertical modes, ~1 ms, are far below any analysis step)
+K_AXIAL = 1e10
 _WIDTH = 99
 
 
@@ -84,137 +104,67 @@ def opensees_script(
         raise InputError("mu", mu, "a finite friction coefficient > 0")
     if not (np.isfinite(k_init) and k_init > 0.0):
         raise InputError("k_init", k_init, "a finite stiffness > 0 [N/m]")
-    t = _tables(model, mu)
+    t = script_tables(model, mu)
     materials = _spring_materials(model, hysteresis)
     dense = model.n_dof <= DENSE_MAX_DOF
     mu_d_differs = bool(mu is None and np.any(model.pallet_mu_dynamic != model.pallet_mu_static))
     if mu_d_differs and pallets == "friction":
         log.warning("the OpenSees friction elements use mu_static; the rack's lower dynamic "
                     "coefficients are not represented")
+    three_d = model.ndm == 3
+    xyz = "(x, y, z)" if three_d else "(x, y)"
+    slots = "ux, uy, uz, rx, ry, rz" if three_d else "ux, uy, rz"
     parts = [
-        _header(model, pallets, mu, k_init, record, source, mu_d_differs, materials),
+        header(model, pallets, mu, k_init, record, source, mu_d_differs, materials),
         "import math\n\nimport openseespy.opensees as ops\n",
         f"TITLE = {model.title or 'seisrack rack'!r}",
+        f"NDM, NDF = {model.ndm}, {model.mesh.ndf}  # coordinates and DOFs per node",
         f"PALLET_MODE = {pallets!r}  # 'friction' or 'rigid': how build() joins the pallets",
         f"G = {_f(model.g)}  # [m/s2]",
-        f"K_INIT = {_f(k_init)}  # [N/m] initial stiffness of the friction springs",
+        f"K_INIT = {_f(k_init)}  # [N/m] initial stiffness of the friction "
+        + ("bearings" if three_d else "springs"),
+        *([f"K_AXIAL = {_f(K_AXIAL)}  # [N/m] axial stiffness of the friction bearings"]
+          if three_d else []),
+        "GEOM_TRANSF = 'Linear'  # 'PDelta': OpenSees' P-Delta chord term (gravity() first)",
         f"RAYLEIGH = ({_f(model.damping_coefficients[0])}, "
         f"{_f(model.damping_coefficients[1])})  # (a0, a1): C = a0 M + a1 K",
         f"EIGEN_SOLVER = {'-fullGenLapack' if dense else '-genBandArpack'!r}",
         f"SYSTEM = {'BandGeneral' if dense else 'SparseSYM'!r}  # of run()",
         "",
-        _table("NODES", "(x, y) [m]; tag = position + 1", t["nodes"]),
-        _table("FIX", "(node, fix ux, fix uy, fix rz) of the supports", t["fix"]),
+        _table("NODES", f"{xyz} [m]; tag = position + 1", t["nodes"]),
+        _table("FIX", f"(node, fix {slots}) of the supports", t["fix"]),
         _table("EQUAL_DOF", "(retained node, constrained node, directions): shared DOFs",
                t["equal_dof"]),
-        _table("SECTIONS", "(E [Pa], A [m2], I [m4], mass per length [kg/m]); tag = position "
-               "+ 1", t["sections"]),
-        _table("MEMBERS", "(node i, node j, section) of each dispBeamColumn; tag = position + 1",
-               t["members"]),
-        _table("GROUND_NODES", "(tag, x, y): fixed nodes for the springs to the ground",
+        _table("SECTIONS", ("(E [Pa], A [m2], Iz [m4], Iy [m4], G' [Pa], J' [m4], mass per "
+                            "length [kg/m]),\n# J' = Ip, G' = G J / Ip" if three_d else
+                            "(E [Pa], A [m2], I [m4], mass per length [kg/m])")
+               + "; tag = position + 1", t["sections"]),
+        _table("TRANSFORMS", "vecxz of each geometric transformation (() in 2D); tag = "
+               "position + 1", t["transforms"]),
+        _table("MEMBERS", ("(node i, node j, section, transformation) of each "
+                           "elasticBeamColumn" if three_d else
+                           "(node i, node j, section) of each dispBeamColumn")
+               + "; tag = position + 1", t["members"]),
+        _table("TRUSSES", "(node i, node j, E [Pa], A [m2], mass per length [kg/m]) of each "
+               "bar;\n# tag = len(MEMBERS) + len(SPRINGS) + position + 1", t["trusses"]),
+        _table("GROUND_NODES", f"(tag, {xyz[1:-1]}): fixed nodes for the springs to the ground",
                t["ground"]),
         _table("SPRINGS", "(node i, node j, direction, k [N m/rad or N/m]): zeroLength Elastic;"
                " tag = len(MEMBERS) + position + 1", t["springs"]),
         _table("SPRING_MATERIALS", "per spring, uniaxialMaterial (type, args...) of its "
                "[hysteresis] law; empty: Elastic k", materials),
-        _table("VERTICAL_MASS", "(node, mass [kg]): the pallets' vertical masses",
-               t["vertical_mass"]),
-        _table("PALLETS", "(own node, beam node, mass [kg], mu, 0-based level), in input order",
-               t["pallets"]),
+        _table("VERTICAL_MASS", "(node, mass [kg]): the pallets' vertical masses on their "
+               "supports", t["vertical_mass"]),
+        _table("PALLETS", "(own node, " + ("(support nodes)" if three_d else "beam node")
+               + ", mass [kg], mu, 0-based level), in input order", t["pallets"]),
         _table("LEVEL_NODES", "per level, bottom to top: one node per distinct ux DOF",
                t["levels"]),
+        _table("LEVEL_NODES_Z", "per level, bottom to top: one node per distinct uz DOF (3D)",
+               t["levels_z"]),
         _record(record),
         FUNCTIONS.strip("\n"),
     ]
     return "\n".join(parts) + "\n"
-
-
-def _tables(model: Any, mu: float | None) -> dict[str, list]:
-    """The data tables of the script (OpenSees tags, 1-based) from the compiled model."""
-    mesh = model.mesh
-    n_node = int(mesh.nodes.shape[0])
-    owner: dict[int, tuple[int, int]] = {}  # dof -> (node index, direction 0..2)
-    ties: dict[tuple[int, int], list[int]] = {}
-    fix = []
-    for i in range(n_node):
-        d = [int(v) for v in mesh.node_dofs[i]]
-        if any(v < 0 for v in d):
-            fix.append((i + 1, *(int(v < 0) for v in d)))
-        for k in range(3):
-            if d[k] < 0:
-                continue
-            if d[k] in owner:
-                m_node, m_dir = owner[d[k]]
-                if m_dir != k:
-                    raise InputError("mesh.node_dofs", f"DOF {d[k]} in two directions",
-                                     "a DOF shared by nodes in one direction")
-                ties.setdefault((m_node, i), []).append(k + 1)
-            else:
-                owner[d[k]] = (i, k)
-    equal_dof = [(a + 1, b + 1, tuple(dirs)) for (a, b), dirs in ties.items()]
-
-    sections: dict[tuple[float, float, float, float], int] = {}
-    members = []
-    for e, (i, j) in enumerate(mesh.elements):
-        key = (float(mesh.E[e]), float(mesh.A[e]), float(mesh.I[e]),
-               float(mesh.density[e] * mesh.A[e]))
-        sec = sections.setdefault(key, len(sections) + 1)
-        members.append((int(i) + 1, int(j) + 1, sec))
-
-    next_node = n_node + 1
-    ground, springs = [], []
-    for n, ((da, db), k) in enumerate(zip(mesh.springs, mesh.spring_k, strict=True)):
-        da, db = _oriented(model, n, int(da), int(db))
-        a = owner.get(int(da)) if da >= 0 else None
-        b = owner.get(int(db)) if db >= 0 else None
-        if a is None and b is None:
-            continue
-        if a is None or b is None:
-            free = a if a is not None else b
-            assert free is not None
-            gx, gy = mesh.nodes[free[0]]
-            ground.append((next_node, float(gx), float(gy)))
-            springs.append((next_node, free[0] + 1, free[1] + 1, float(k)))
-            next_node += 1
-        else:
-            if a[1] != b[1]:
-                raise InputError("mesh.springs", f"DOFs {da}, {db}", "DOFs of one direction")
-            springs.append((a[0] + 1, b[0] + 1, a[1] + 1, float(k)))
-
-    m = int(model.pallet_mass.size)
-    mus = np.broadcast_to(np.asarray(model.pallet_mu_static if mu is None else mu, float), (m,))
-    level_of_dof = {int(d): lv for lv, dofs in enumerate(model.level_dofs) for d in dofs}
-    vertical: dict[int, float] = {}
-    pallet_rows = []
-    for j in range(m):
-        mass = float(model.pallet_mass[j])
-        vn = owner[int(model.pallet_vdof[j])][0] + 1
-        vertical[vn] = vertical.get(vn, 0.0) + mass  # ops.mass replaces: sum per node first
-        bn = owner[int(model.pallet_dof[j])][0] + 1
-        pallet_rows.append((next_node, bn, mass, float(mus[j]),
-                            level_of_dof[int(model.pallet_dof[j])]))
-        next_node += 1
-    levels = [[owner[int(d)][0] + 1 for d in dofs] for dofs in model.level_dofs]
-    return {
-        "nodes": [(float(x), float(y)) for x, y in mesh.nodes],
-        "fix": fix, "equal_dof": equal_dof, "sections": list(sections), "members": members,
-        "ground": ground, "springs": springs, "vertical_mass": list(vertical.items()),
-        "pallets": pallet_rows, "levels": levels,
-    }
-
-
-def _oriented(model: Any, n: int, da: int, db: int) -> tuple[int, int]:
-    """Spring ``n``'s DOFs ordered (b, a) after its hinge (``model.hinge_dofs[n] = (a, b)``), so
-    that the zeroLength deformation u_j − u_i is the hinge rotation u[a] − u[b]."""
-    hd = getattr(model, "hinge_dofs", None)
-    if hd is None:
-        return da, db
-    a, b = (int(v) for v in hd[n])
-    if {a, b} != {da, db}:
-        raise InputError("model.hinge_dofs", f"hinge {n}: DOFs ({a}, {b})",
-                         f"the DOFs ({da}, {db}) of spring {n} of mesh.springs (one hinge per "
-                         "spring, in the same order)")
-    return b, a
 
 
 def _spring_materials(model: Any, hysteresis: Any) -> list[tuple]:
@@ -312,55 +262,3 @@ def _record(record: Any) -> str:
     lines.extend("    " + s for s in _pack(_f(a) for a in accel))
     lines += ["    ],", "}", ""]
     return "\n".join(lines)
-
-
-def _header(model: Any, pallets: str, mu: float | None, k_init: float, record: Any,
-            source: str | None, mu_d_differs: bool, materials: Sequence[tuple] = ()) -> str:
-    mu_text = (f"mu = {mu:g} for every pallet" if mu is not None
-               else "each pallet's mu_static from the rack file")
-    mu_note = ("\nNOTE: some pallets have mu_dynamic < mu_static; this model uses mu_static "
-               "(it cannot\nhold two coefficients), so it slides later and less than seisrack "
-               "there.\n" if mu_d_differs else "")
-    kinds = sorted({m[0] for m in materials})
-    hyst = (f"\n- connections: nonlinear ([hysteresis]): zeroLength with {', '.join(kinds)} "
-            "(see\n  SPRING_MATERIALS); zeroLength deformation u_j - u_i = seisrack's hinge "
-            "rotation." if materials else "")
-    pd_note = ("\nNOTE: the rack has P-Delta ([second_order]) in seisrack; this script uses a "
-               "Linear\ntransformation, so it leaves P-Delta out.\n"
-               if getattr(model, "critical_load_factor", None) is not None else "")
-    rec = f"\nGround motion: {record.name} (dt {record.dt:g} s), run by `python` this script.\n" \
-        if record is not None else ""
-    a0, a1 = model.damping_coefficients
-    text = f'''"""OpenSeesPy model of: {model.title or "a seisrack rack"}
-
-Exported by seisrack {__version__} (`seisrack export opensees`) from {source or "a compiled rack"}.
-{model.n_dof} free DOFs in seisrack, {model.mesh.nodes.shape[0]} nodes, {model.mesh.n_el} members, \
-{model.mesh.springs.shape[0]} connector springs, {model.n_pallets} pallets.
-Units: SI (m, kg, s, N, Pa).
-
-Use: `python {{this file}}` prints the first periods; `import` it for build(), modal(n),
-gravity() and run(ag, dt) (gravity first, then the ground acceleration ag [m/s2] sampled at
-dt [s]; returns the peak level displacements [m] from the gravity state).
-
-Modelling choices (as seisrack's compiled model, node for node):
-- members: dispBeamColumn, Elastic section, 3-point Gauss-Legendre, Linear transformation,
-  consistent mass (-cMass): exactly seisrack's cubic-Hermite beam element. Not
-  elasticBeamColumn: in OpenSeesPy 3.7.1 its element mass receives the ground-motion load
-  twice under UniformExcitation (measured; see seisrack's benchmarks/opensees_rack.py).
-- semi-rigid joints: the beam end is its own node, equalDOF 1 2 to the upright node, with a
-  zeroLength Elastic rotational spring; base springs go to fixed extra nodes.{hyst}
-- pallets (default mode here: {pallets}): vertical mass on the beam node; horizontal mass on
-  the pallet's own node (uy, rz fixed), joined to the beam node by
-  * "friction": a zeroLength with ElasticPP(K_INIT, mu m g / K_INIT), a regularised Coulomb
-    law with a constant normal force m g and mu_s = mu_d; {mu_text};
-    K_INIT = {k_init:g} N/m. Limits: no static/dynamic distinction, no vertical excitation, and the
-    elastic stage needs sqrt(K_INIT / m) dt well below 1 (results move with K_INIT and dt);
-  * "rigid": equalDOF in ux (no sliding): the pallets move with their beam node.
-- damping: Rayleigh C = a0 M + a1 K_initial with a0 = {a0:.6g}, a1 = {a1:.6g} on the
-  structure only (regions when a0 != 0); the pallets' horizontal masses and friction elements
-  are undamped.
-- analysis in run(): UniformExcitation (direction 1, Path time series), Newmark average
-  acceleration, Newton + NormDispIncr, Transformation constraints.
-{mu_note}{pd_note}{rec}"""
-'''
-    return text

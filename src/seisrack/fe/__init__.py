@@ -1,4 +1,5 @@
-"""2D Euler–Bernoulli frame finite elements: matrices, assembly, damping, modes, recovery."""
+"""Euler–Bernoulli frame finite elements (plane and space): matrices, assembly, damping, modes,
+recovery."""
 
 from seisrack.fe.assembly import assemble, assemble_sparse, scatter
 from seisrack.fe.mesh import FrameMesh, line_mesh

@@ -1,4 +1,4 @@
-"""Assembly: one COO scatter of all element (and spring) matrices into a global matrix.
+"""Assembly: one COO scatter of all element, bar and spring matrices into a global matrix.
 
 As in scikit-fem, the loop (implicit, via broadcasting) runs over local entries, never over
 elements: the (n_el, k, k) blocks and their (n_el, k) DOF tables are flattened into COO triplets,
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from seisrack.fe.elements import element_matrices
+from seisrack.fe.frame_elements import element_matrices, truss_matrices
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
 
 
@@ -40,15 +40,21 @@ def symmetric_csr(A: sp.spmatrix) -> sp.csr_matrix:
 
 
 def assemble_sparse(mesh: FrameMesh) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-    """Global stiffness K [N/m …] and consistent mass M [kg …], each (n_dof, n_dof) CSR.
+    """Global stiffness K [N/m …] and consistent mass M [kg …], each (n_dof, n_dof) CSR, of the
+    beam-columns, bars and springs of a 2D or 3D mesh.
 
     Both are exactly symmetric (averaged with their transpose) and in canonical CSR form.
     """
+    n = mesh.n_dof
     ke, me = element_matrices(mesh)
-    K = scatter(ke, mesh.element_dofs, mesh.n_dof)
+    K = scatter(ke, mesh.element_dofs, n)
+    M = scatter(me, mesh.element_dofs, n)
+    if mesh.trusses.shape[0]:
+        kt, mt = truss_matrices(mesh)
+        K = K + scatter(kt, mesh.truss_dofs, n)
+        M = M + scatter(mt, mesh.truss_dofs, n)
     if mesh.springs.shape[0]:
-        K = K + scatter(spring_blocks(mesh.spring_k), mesh.springs, mesh.n_dof)
-    M = scatter(me, mesh.element_dofs, mesh.n_dof)
+        K = K + scatter(spring_blocks(mesh.spring_k), mesh.springs, n)
     return symmetric_csr(K), symmetric_csr(M)
 
 

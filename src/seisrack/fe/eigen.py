@@ -53,6 +53,11 @@ class ModalResult:
         mass_participation_y: (n_modes,) same for vertical [-].
         total_mass_x, total_mass_y: [kg].
         status: "ok".
+    A 3D rack adds the cross-aisle (z) and plan-rotation terms (None / 0 for a 2D rack):
+        gamma_z, effective_mass_z [kg], mass_participation_z [-]: (n_modes,); total_mass_z.
+        gamma_theta, effective_inertia_theta [kg·m²], participation_theta [-]: (n_modes,);
+        total_inertia_theta [kg·m²] about the vertical through the plan mass centre.
+        direction: (n_modes,) str class of each mode (see :mod:`seisrack.fe.modal`).
     """
 
     periods: FloatArray
@@ -68,6 +73,15 @@ class ModalResult:
     total_mass_x: float
     total_mass_y: float
     status: str = "ok"
+    gamma_z: FloatArray | None = None
+    effective_mass_z: FloatArray | None = None
+    mass_participation_z: FloatArray | None = None
+    total_mass_z: float = 0.0
+    gamma_theta: FloatArray | None = None
+    effective_inertia_theta: FloatArray | None = None
+    participation_theta: FloatArray | None = None
+    total_inertia_theta: float = 0.0
+    direction: tuple[str, ...] = ()
 
     @property
     def n_modes(self) -> int:

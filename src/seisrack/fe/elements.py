@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from seisrack.fe.mesh import FloatArray, FrameMesh
+from seisrack.fe.mesh import FloatArray
 
 
 def local_stiffness(E: FloatArray, A: FloatArray, I: FloatArray, L: FloatArray) -> FloatArray:
@@ -64,15 +64,5 @@ def rotation(c: FloatArray, s: FloatArray) -> FloatArray:
 
 
 def to_global(k_local: FloatArray, T: FloatArray) -> FloatArray:
-    """Tᵀ k T for every element."""
+    """Tᵀ k T for every element (any size of element matrix)."""
     return np.einsum("eji,ejk,ekl->eil", T, k_local, T)
-
-
-def element_matrices(mesh: FrameMesh) -> tuple[FloatArray, FloatArray]:
-    """Global-axis element stiffness and consistent mass, each (n_el, 6, 6)."""
-    L = mesh.lengths
-    c, s = mesh.direction_cosines
-    T = rotation(c, s)
-    k = to_global(local_stiffness(mesh.E, mesh.A, mesh.I, L), T)
-    m = to_global(local_consistent_mass(mesh.density * mesh.A, L), T)
-    return k, m

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from seisrack.fe.elements import to_global
 from seisrack.fe.mesh import FloatArray
 
 # Hermite bending block on (v_i, θ_i, v_j, θ_j) and the powers of L of its entries.
@@ -114,11 +115,6 @@ def transformation_3d(lam: FloatArray) -> FloatArray:
     for o in (0, 3, 6, 9):  # four 3x3 blocks, not a loop over elements
         T[:, o:o + 3, o:o + 3] = lam
     return T
-
-
-def to_global(k_local: FloatArray, T: FloatArray) -> FloatArray:
-    """Tᵀ k T for every element."""
-    return np.einsum("eji,ejk,ekl->eil", T, k_local, T)
 
 
 def beam_matrices_3d(xi: FloatArray, xj: FloatArray, vecxz: FloatArray, *, E: FloatArray,

@@ -1,10 +1,13 @@
-"""Linear geometric stiffness (P-Δ) of 2D beam-column elements, vectorised over elements.
+"""Linear geometric stiffness (P-Δ) of beam-columns and bars, 2D or 3D, vectorised over
+elements.
 
 Sign convention: ``N`` is the element axial force, **tension positive** (as in
 :mod:`seisrack.fe.recovery`: ``N = N_j = -N_i``). A compressed member (N < 0) softens the frame:
 the second-order stiffness is ``K = K_E + K_G(N)``.
 
-Two forms, local DOFs ``[u_i, v_i, θ_i, u_j, v_j, θ_j]``:
+Two forms for a beam-column, in each bending plane (the plane member's one; a space member's
+x–y plane on (v, θz) and x–z plane on (w, θy), where θy = −dw/dx flips the signs of the
+rotation rows, as in :mod:`seisrack.fe.elements3d`):
 
 - ``"consistent"``: the geometric stiffness of the cubic-Hermite element,
   k_G = ∫ N v'ᵀ v' dx (Przemieniecki, *Theory of Matrix Structural Analysis*, 1968, ch. 15;
@@ -19,13 +22,23 @@ Two forms, local DOFs ``[u_i, v_i, θ_i, u_j, v_j, θ_j]``:
             [ L/10  -L²/30  -L/10  2L²/15 ]
 
   It captures P-δ within the element: a cantilever's Euler load converges as h⁴.
-- ``"p_delta_only"``: the chord-rotation term alone, N/L·[[1, -1], [-1, 1]] on (v_i, v_j), the
-  form of OpenSees' ``geomTransf PDelta`` (PDeltaCrdTransf2d). It converges as h² with the number
-  of elements per member.
+- ``"p_delta_only"``: the chord-rotation term alone, N/L·[[1, -1], [-1, 1]] on (v_i, v_j) (and
+  on (w_i, w_j) in 3D), the form of OpenSees' ``geomTransf PDelta`` (PDeltaCrdTransf2d/3d).
+  It converges as h² with the number of elements per member.
 
-The axial forces come from a linear static solve under gravity (:func:`gravity_axial_forces`)
-and the lowest buckling load factor from a sparse generalised eigenproblem
-(:func:`critical_load_factor`).
+A space member's geometric stiffness here is that of bending in its two principal planes: the
+terms coupling N with the twist (Wagner's N·Ip/(A L) on θx, McGuire et al. §9.3) and the end
+moments are left out, as in OpenSees' PDelta transformation. They govern the flexural-torsional
+buckling of one member, which the member checks of the rack's design standard cover (EN 15512
+§9), not the sway of the frame that P-Δ is for.
+
+A pin-ended bar (3D bracing) has the exact string stiffness k_G = N/L [[P, −P], [−P, P]] on its
+end translations, P = I − n nᵀ with n the unit axis (McGuire et al. §9.2): a compressed bar
+softens the transverse motion of its ends, as a compressed beam-column's chord term does.
+
+The axial forces come from a linear static solve under gravity (:func:`gravity_axial_forces`,
+:func:`static_axial_forces`) and the lowest buckling load factor from a sparse generalised
+eigenproblem (:func:`critical_load_factor`).
 """
 
 from __future__ import annotations
@@ -38,7 +51,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from seisrack.fe.assembly import scatter, symmetric_csr
-from seisrack.fe.elements import rotation, to_global
+from seisrack.fe.elements import to_global
+from seisrack.fe.frame_elements import local_frames
 from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.fe.recovery import element_end_forces
 from seisrack.fe.stability import symmetric_lu
@@ -51,50 +65,97 @@ DENSE_MAX_DOF = 500
 MU_NONE = 1e-12
 
 
+#: the consistent form's bending block on (v_i, θ_i, v_j, θ_j), times N/L · L^power
+_BEND = np.array([[6 / 5, 1 / 10, -6 / 5, 1 / 10],
+                  [1 / 10, 2 / 15, -1 / 10, -1 / 30],
+                  [-6 / 5, -1 / 10, 6 / 5, -1 / 10],
+                  [1 / 10, -1 / 30, -1 / 10, 2 / 15]])
+_P = np.array([0, 1, 0, 1])  # powers of L carried by each entry (v: L^0, θ: L^1)
+_POW = _P[:, None] + _P[None, :]
+#: per element size (6: plane, 12: space), each bending plane's local (v_i, θ_i, v_j, θ_j)
+#: and the sign of its rotation rows (θy = −dw/dx in the x–z plane)
+_PLANES = {6: ((np.array([1, 2, 4, 5]), np.ones(4)),),
+           12: ((np.array([1, 5, 7, 11]), np.ones(4)),
+                (np.array([2, 4, 8, 10]), np.array([1.0, -1.0, 1.0, -1.0])))}
+#: the axial end force N_j in the local end forces, by element size
+_AXIAL_J = {6: 3, 12: 6}
+
+
 def local_geometric_stiffness(N: FloatArray, L: FloatArray,
-                              form: GeometricForm = "consistent") -> FloatArray:
-    """(n_el, 6, 6) local geometric stiffness [N/m, N, N·m] for axial forces ``N`` (n_el,) [N],
-    tension positive, and lengths ``L`` (n_el,) [m]."""
-    n = L.shape[0]
-    k = np.zeros((n, 6, 6))
-    a = N / L
-    if form == "p_delta_only":
-        k[:, 1, 1] = k[:, 4, 4] = a
-        k[:, 1, 4] = k[:, 4, 1] = -a
-        return k
-    if form != "consistent":
+                              form: GeometricForm = "consistent", ndm: int = 2) -> FloatArray:
+    """(n_el, 2·ndf, 2·ndf) local geometric stiffness [N/m, N, N·m] of plane (``ndm`` 2:
+    6 x 6) or space (3: 12 x 12) beam-columns, for axial forces ``N`` (n_el,) [N], tension
+    positive, and lengths ``L`` (n_el,) [m]."""
+    if form not in FORMS:
         raise ValueError(f"form must be one of {FORMS}, not {form!r}")
-    # the matrix of the module docstring (bending part of the consistent form)
-    bend = np.array([[6 / 5, 1 / 10, -6 / 5, 1 / 10],
-                     [1 / 10, 2 / 15, -1 / 10, -1 / 30],
-                     [-6 / 5, -1 / 10, 6 / 5, -1 / 10],
-                     [1 / 10, -1 / 30, -1 / 10, 2 / 15]])
-    p = np.array([0, 1, 0, 1])  # powers of L carried by each entry (v: L^0, θ: L^1)
-    powers = p[:, None] + p[None, :]
-    idx = np.array([1, 2, 4, 5])
-    k[:, idx[:, None], idx[None, :]] = a[:, None, None] * bend * L[:, None, None] ** powers
+    size = 6 if ndm == 2 else 12
+    k = np.zeros((L.shape[0], size, size))
+    a = N / L
+    for idx, sign in _PLANES[size]:
+        if form == "p_delta_only":  # the chord term on the two transverse translations
+            i, j = idx[0], idx[2]
+            k[:, i, i] += a
+            k[:, j, j] += a
+            k[:, i, j] -= a
+            k[:, j, i] -= a
+            continue
+        block = _BEND * np.outer(sign, sign)
+        k[:, idx[:, None], idx[None, :]] += a[:, None, None] * block * L[:, None, None] ** _POW
     return k
 
 
-def geometric_stiffness(mesh: FrameMesh, N: FloatArray,
-                        form: GeometricForm = "consistent") -> sp.csr_matrix:
-    """Global geometric stiffness K_G (n_dof, n_dof) CSR, symmetric and canonical, for element
-    axial forces ``N`` (n_el,) [N], tension positive."""
-    c, s = mesh.direction_cosines
-    kg = to_global(local_geometric_stiffness(np.asarray(N, float), mesh.lengths, form),
-                   rotation(c, s))
-    return symmetric_csr(scatter(kg, mesh.element_dofs, mesh.n_dof))
+def bar_geometric_stiffness(mesh: FrameMesh, N_bar: FloatArray) -> FloatArray:
+    """(n_tr, 2·ndm, 2·ndm) global geometric stiffness of the pin-ended bars for axial forces
+    ``N_bar`` (n_tr,) [N], tension positive (module docstring)."""
+    X = mesh.nodes
+    d = X[mesh.trusses[:, 1]] - X[mesh.trusses[:, 0]]
+    L = np.linalg.norm(d, axis=1)
+    n = d / L[:, None]
+    P = np.eye(mesh.ndm)[None] - np.einsum("ei,ej->eij", n, n)
+    two = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    k = np.einsum("ab,eij->eaibj", two, P).reshape(-1, 2 * mesh.ndm, 2 * mesh.ndm)
+    return k * (np.asarray(N_bar, float) / L)[:, None, None]
+
+
+def geometric_stiffness(mesh: FrameMesh, N: FloatArray, form: GeometricForm = "consistent",
+                        N_bar: FloatArray | None = None) -> sp.csr_matrix:
+    """Global geometric stiffness K_G (n_dof, n_dof) CSR, symmetric and canonical, for
+    beam-column axial forces ``N`` (n_el,) [N] and, when given, bar axial forces ``N_bar``
+    (n_tr,) [N], tension positive; a plane or a space mesh."""
+    kl = local_geometric_stiffness(np.asarray(N, float), mesh.lengths, form, mesh.ndm)
+    K = scatter(to_global(kl, local_frames(mesh)), mesh.element_dofs, mesh.n_dof)
+    if N_bar is not None and mesh.trusses.shape[0]:
+        K = K + scatter(bar_geometric_stiffness(mesh, N_bar), mesh.truss_dofs, mesh.n_dof)
+    return symmetric_csr(K)
+
+
+def axial_forces(mesh: FrameMesh, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Axial forces [N], tension positive, for free-DOF displacements ``u`` (n_dof,): of the
+    beam-columns (n_el,), their mean force EA (u_j − u_i)/L (which a uniform-N geometric
+    stiffness needs: a member's own weight makes N vary linearly along it), and of the bars
+    (n_tr,)."""
+    N = element_end_forces(mesh, u)[:, _AXIAL_J[2 * mesh.ndf]]
+    if not mesh.trusses.shape[0]:
+        return N, np.zeros(0)
+    ut = np.append(np.asarray(u, float), 0.0)[mesh.truss_dofs]  # -1 (fixed) reads 0
+    nd = mesh.ndm
+    X = mesh.nodes
+    d = X[mesh.trusses[:, 1]] - X[mesh.trusses[:, 0]]
+    L = np.linalg.norm(d, axis=1)
+    stretch = np.einsum("ei,ei->e", d / L[:, None], ut[:, nd:] - ut[:, :nd])
+    return N, mesh.truss_E * mesh.truss_A / L * stretch
+
+
+def static_axial_forces(mesh: FrameMesh, K: sp.spmatrix, F: FloatArray
+                        ) -> tuple[FloatArray, FloatArray]:
+    """(:func:`axial_forces`) of the linear static solution K u = F (``F`` (n_dof,) [N, N·m],
+    e.g. -g·M·r_y for gravity): beam-column (n_el,) and bar (n_tr,) axial forces [N]."""
+    return axial_forces(mesh, symmetric_lu(K).solve(np.asarray(F, float)))
 
 
 def gravity_axial_forces(mesh: FrameMesh, K: sp.spmatrix, F: FloatArray) -> FloatArray:
-    """(n_el,) [N] axial force of each element (tension positive) from the linear static solution
-    K u = F (``F`` (n_dof,) [N, N·m], e.g. -g·M·r_y for gravity).
-
-    The force is the element's mean axial force EA (u_j − u_i)/L, which is what a uniform-N
-    geometric stiffness needs (a member's own weight makes N vary linearly along it).
-    """
-    u = symmetric_lu(K).solve(np.asarray(F, float))
-    return element_end_forces(mesh, u)[:, 3]
+    """(n_el,) [N] the beam-columns' axial forces of :func:`static_axial_forces`."""
+    return static_axial_forces(mesh, K, F)[0]
 
 
 def critical_load_factor(K_E: sp.spmatrix, K_G: sp.spmatrix) -> float:

@@ -33,6 +33,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from seisrack.limits import MAX_PANEL_POINTS
 from seisrack.model._reader import Table, check_number
 
 PATTERNS = ("Z", "D", "K", "X")
@@ -108,6 +109,9 @@ def _panel_points(t: Table, top: float) -> tuple[float, ...]:
     if isinstance(raw, list):
         pts = [check_number(v, f"{t.field('panel')}[{i}]", nonnegative=True, unit="m",
                             source=t.source) for i, v in enumerate(raw)]
+        if len(pts) > MAX_PANEL_POINTS:
+            raise t.error("panel", f"{len(pts)} heights", f"at most {MAX_PANEL_POINTS} panel "
+                                                          "points on an upright")
         if len(pts) < 2 or any(b <= a for a, b in zip(pts[:-1], pts[1:], strict=True)) \
                 or pts[-1] > top + _TOL:
             raise t.error("panel", raw, f"an increasing array of at least 2 heights in "
@@ -117,6 +121,10 @@ def _panel_points(t: Table, top: float) -> tuple[float, ...]:
     if h > top + _TOL:
         raise t.error("panel", raw, f"a panel height <= the upright height {top:g} m")
     n = int(math.floor(top / h + 1e-9))
+    if n + 1 > MAX_PANEL_POINTS:  # checked before the points are built (a mm for m typo)
+        raise t.error("panel", h, f"a panel height >= {top / (MAX_PANEL_POINTS - 1):.3g} m "
+                      f"(at most {MAX_PANEL_POINTS} panel points on the {top:g} m upright)",
+                      hint=f"{h:g} m gives {n + 1:,} panel points; is the panel in metres?")
     pts = [k * h for k in range(n + 1)]
     if top - pts[-1] > 1e-6 * top:
         pts.append(top)

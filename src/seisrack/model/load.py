@@ -11,6 +11,7 @@ optional ``[loading]`` table generates pallets (:mod:`seisrack.model.loading`).
 
 from __future__ import annotations
 
+import bisect
 import math
 import re
 import tomllib
@@ -19,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_COUNT, MAX_SUBDIVISIONS, check_rack_size, rack_size
 from seisrack.model._reader import Table, check_friction, check_number
 from seisrack.model.loading import place_pallets, read_loading
 from seisrack.model.spec import (
@@ -34,6 +36,7 @@ from seisrack.model.spec import (
     Material,
     Pallet,
     RackSpec,
+    RowSpacer,
     SecondOrder,
     Section,
 )
@@ -51,7 +54,7 @@ def load_rack(path: str | Path) -> RackSpec:
     with p.open("rb") as fh:
         raw = fh.read()
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        data = tomllib.loads(raw.decode("utf-8-sig"))  # a BOM (Windows Notepad) is fine
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
     except tomllib.TOMLDecodeError as exc:
@@ -92,10 +95,15 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
                      lt.path, source)
         loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
+    _check_size(geometry, bracing, loading, len(explicit), source)
     pallets, labels = place_pallets(loading, geometry, explicit)
+    fields = [{k: f"{lab}.{k}" for k in _PALLET_3D_KEYS} for lab in labels]
     if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
+        for p, f in zip(pallets, fields, strict=True):
+            f.update({k: f"loading.{k}" for k in footprint if getattr(p, k) is None})
         pallets = tuple(replace(p, **{k: v for k, v in footprint.items()
                                       if getattr(p, k) is None}) for p in pallets)
+    _check_footprints(pallets, fields, geometry, source)
     _check_overlaps(pallets, labels, source)
     return RackSpec(material=material, sections=sections, geometry=geometry,
                     connections=connections, damping=damping, pallets=pallets, g=g,
@@ -166,6 +174,9 @@ def _lengths(t: Table, key: str) -> tuple[float, ...]:
     if isinstance(value, dict):
         c = t.table(key)
         count = c.integer("count", minimum=1)
+        if count > MAX_COUNT:  # before the lengths are built
+            raise c.error("count", count, f"an integer from 1 to {MAX_COUNT:,}",
+                          hint="Model a part of the row: bays far apart behave alike")
         pitch = c.number("pitch", positive=True, unit="m")
         c.finish(("count", "pitch"))
         return (pitch,) * count
@@ -179,15 +190,109 @@ def _lengths(t: Table, key: str) -> tuple[float, ...]:
 def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
     bays = _lengths(t, "bays")
     levels = _lengths(t, "levels")
+    depth = t.number("depth", positive=True, unit="m") if t.has("depth") else None
+    rows, spacer = _rows(t, sum(levels), depth, sections)
     geom = Geometry(
         bays=bays, levels=levels,
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
         upright_sections=_section_names(t, "upright_section", len(levels), "storey", sections),
-        subdivisions=t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1),
-        depth=t.number("depth", positive=True, unit="m") if t.has("depth") else None,
+        subdivisions=_subdivisions(t),
+        depth=depth, rows=rows, row_spacer=spacer,
     )
-    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth"))
+    t.finish(("bays", "levels", "beam_section", "upright_section", "subdivisions", "depth",
+              "rows", "row_spacer"))
     return geom
+
+
+def _rows(t: Table, top: float, depth: float | None, sections: dict[str, Section]
+          ) -> tuple[int, RowSpacer | None]:
+    """``rows`` (1, or 2 back to back) and ``[geometry.row_spacer]``: 3D racks only."""
+    if depth is None:
+        for key in ("rows", "row_spacer"):
+            if t.has(key):
+                raise t.error(key, t.raw(key), "no rows or row spacers in a 2D rack (they "
+                              "are keys of a 3D rack)", hint="Give [geometry] depth (the "
+                              "upright-frame depth, m) for a 3D rack, then rows = 2 and "
+                              "[geometry.row_spacer] for a back-to-back (double-entry) rack")
+        return 1, None
+    rows = t.integer("rows", 1)
+    if rows not in (1, 2):
+        raise t.error("rows", rows, "1 (one row of upright frames) or 2 (two rows back to "
+                                    "back, joined by [geometry.row_spacer])")
+    if rows == 1:
+        if t.has("row_spacer"):
+            raise t.error("row_spacer", t.raw("row_spacer"), "no row spacer on a rack of one "
+                          "row", hint="Set [geometry] rows = 2 for a back-to-back rack")
+        return 1, None
+    if not t.has("row_spacer"):
+        raise t.error("row_spacer", None, "a [geometry.row_spacer] table (length, section, "
+                      "spacing or heights): two rows back to back are joined by row spacers")
+    st = t.table("row_spacer")
+    length = st.number("length", positive=True, unit="m")
+    section = st.string("section")
+    if section not in sections:
+        raise st.error("section", section, f"one of the [sections]: {', '.join(sorted(sections))}")
+    if st.has("spacing") == st.has("heights"):
+        raise st.error("spacing", st.raw("spacing", None), "either spacing (a vertical spacing, "
+                       "m) or heights (a list of heights, m), not both and not neither")
+    if st.has("spacing"):
+        h = st.number("spacing", positive=True, unit="m")
+        if h > top + _GEOM_TOL:
+            raise st.error("spacing", h, f"a spacing <= the upright height {top:g} m (a "
+                           "spacer must fit on the uprights)")
+        n = int(math.floor(top / h + 1e-9))
+        heights = [k * h for k in range(1, n + 1)]
+        if top - heights[-1] > 1e-6 * top:
+            heights.append(top)  # and one at the top of the uprights
+    else:
+        raw = st.array("heights", min_len=1)
+        heights = [check_number(v, f"{st.field('heights')}[{i}]", positive=True, unit="m",
+                                source=st.source) for i, v in enumerate(raw)]
+        if any(b <= a for a, b in zip(heights[:-1], heights[1:], strict=True)) \
+                or heights[-1] > top + _GEOM_TOL:
+            raise st.error("heights", raw, f"an increasing list of heights in (0, {top:g}] m "
+                           "(on the uprights, above the floor)")
+    st.finish(("length", "section", "spacing", "heights"))
+    return 2, RowSpacer(length=length, section=section, heights=tuple(heights))
+
+
+def _subdivisions(t: Table) -> int:
+    n = t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1)
+    if n > MAX_SUBDIVISIONS:
+        raise t.error("subdivisions", n, f"an integer from 1 to {MAX_SUBDIVISIONS} (default "
+                      f"{DEFAULT_SUBDIVISIONS}, which converges the first modes to about 1e-4)")
+    return n
+
+
+def _check_size(geom: Geometry, bracing: Any, loading: Any, n_explicit: int,
+                source: str | None) -> None:
+    """Refuse a rack too large to build before it is meshed (or its pallets placed)."""
+    n_pallets = n_explicit
+    if loading is not None:  # an upper bound: every slot of every loaded level
+        n_pallets += (sum(1 for lv in loading.levels if loading.level_mass[lv - 1] > 0)
+                      * geom.n_bays * loading.pallets_per_bay * geom.rows)
+    points = 0 if bracing is None else _extra_heights(geom, bracing.panel_points)
+    size = rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
+                     three_d=geom.depth is not None, panel_points=points, rows=geom.rows)
+    check_rack_size(size, n_bays=geom.n_bays, n_levels=geom.n_levels,
+                    subdivisions=geom.subdivisions,
+                    panel=None if bracing is None else f"{points} panel points",
+                    source=source)
+
+
+def _extra_heights(geom: Geometry, panel_points: tuple[float, ...]) -> int:
+    """Panel points that are not already upright nodes (the 3D mesher merges them)."""
+    if geom.n_levels * geom.subdivisions > 1_000_000:
+        return len(panel_points)  # an upper bound, without building a million heights
+    ys = (0.0, *geom.level_y)
+    nodes = sorted(ys[s] + (ys[s + 1] - ys[s]) * i / geom.subdivisions
+                   for s in range(geom.n_levels) for i in range(geom.subdivisions + 1))
+    extra = 0
+    for y in panel_points:
+        i = bisect.bisect_left(nodes, y)
+        near = [abs(nodes[j] - y) for j in (i - 1, i) if 0 <= j < len(nodes)]
+        extra += not near or min(near) > 1e-6
+    return extra
 
 
 def _spring(t: Table, key: str) -> float:
@@ -251,6 +356,37 @@ def _footprint(t: Table, geom: Geometry) -> dict[str, float]:
             raise t.error("depth", depth, f"a pallet depth <= the frame depth + 2 x overhang = "
                                           f"{geom.depth:g} + 2 x {over:g} = {allowed:g} m")
     return out
+
+
+def _check_footprints(pallets: tuple[Pallet, ...], fields: list[dict[str, str]],
+                      geom: Geometry, source: str | None) -> None:
+    """Each 3D pallet rests on the front and the rear beam: its depth and overhang agree with
+    the frame depth. ``fields[i]`` names where pallet i's depth and overhang were written
+    (``pallets[3].depth`` or ``loading.depth``), so the error points at the line to change."""
+    if geom.depth is None:
+        return
+    d = geom.depth
+    for p, f in zip(pallets, fields, strict=True):
+        if p.depth is None:
+            continue
+        if p.overhang is None:
+            if p.depth <= d + _GEOM_TOL:
+                raise InputError(f["depth"], p.depth, f"a pallet deeper than the frame "
+                                 f"({d:g} m): it must rest on the front and the rear beam",
+                                 source=source, hint="Or give its overhang beyond the beams")
+            continue
+        if p.overhang >= p.depth:
+            raise InputError(f["overhang"], p.overhang,
+                             f"an overhang >= 0 and < the pallet depth {p.depth:g} m",
+                             source=source)
+        if p.depth > d + 2.0 * p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a pallet depth <= the frame depth + 2 x "
+                             f"overhang = {d:g} + 2 x {p.overhang:g} = "
+                             f"{d + 2.0 * p.overhang:g} m", source=source)
+        if p.depth <= d + p.overhang + _GEOM_TOL:
+            raise InputError(f["depth"], p.depth, f"a depth > frame depth + overhang = "
+                             f"{d + p.overhang:g} m (the pallet must reach the rear beam)",
+                             source=source)
 
 
 def _period(t: Table, key: str, value: Any) -> float:
@@ -330,6 +466,12 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
     if not 1 <= level <= geom.n_levels:
         raise t.error("level", level, f"an integer from 1 to {geom.n_levels} (the rack has "
                                       f"{geom.n_levels} beam level(s))")
+    row = t.integer("row", 1)
+    if not 1 <= row <= geom.rows:
+        raise t.error("row", row, f"an integer from 1 to {geom.rows} (the rack has "
+                                  f"{geom.rows} row(s) of upright frames)",
+                      hint=None if geom.rows > 1 else "A back-to-back rack has [geometry] "
+                      "rows = 2 (3D racks)")
     mu_s, mu_d = check_friction(t.field("mu_static"), t.raw("mu_static"),
                                 t.field("mu_dynamic"), t.raw("mu_dynamic"), source=t.source)
     width = t.number("width", DEFAULT_PALLET_WIDTH, positive=True, unit="m")
@@ -347,19 +489,20 @@ def _pallet(t: Table, geom: Geometry) -> Pallet:
         limit_raw, t.field("sliding_limit"), nonnegative=True, unit="m", source=t.source)
     rate = friction_rate(t)
     fp = _footprint(t, geom)
-    t.finish(("mass", "bay", "level", "position", "mu_static", "mu_dynamic", "width",
+    t.finish(("mass", "bay", "level", "row", "position", "mu_static", "mu_dynamic", "width",
               "sliding_limit", "friction_rate") + _PALLET_3D_KEYS)
     return Pallet(mass=mass, bay=bay, level=level, position=position, mu_static=mu_s,
                   mu_dynamic=mu_d, width=width, sliding_limit=limit, friction_rate=rate,
-                  depth=fp.get("depth"), overhang=fp.get("overhang"))
+                  depth=fp.get("depth"), overhang=fp.get("overhang"), row=row)
 
 
 def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],
                     source: str | None) -> None:
-    """Pallets on the same bay and level must not overlap (``labels[i]`` names pallet i)."""
-    seen: dict[tuple[int, int], list[int]] = {}  # earlier pallets of each (bay, level)
+    """Pallets on the same bay, level and row must not overlap (``labels[i]`` names pallet
+    i)."""
+    seen: dict[tuple[int, int, int], list[int]] = {}  # earlier pallets of each cell
     for i, a in enumerate(pallets):
-        earlier = seen.setdefault((a.bay, a.level), [])
+        earlier = seen.setdefault((a.row, a.bay, a.level), [])
         for j in earlier:
             b = pallets[j]
             gap = abs(a.position - b.position) - (a.width + b.width) / 2
@@ -367,5 +510,6 @@ def _check_overlaps(pallets: tuple[Pallet, ...], labels: tuple[str, ...],
                 raise InputError(
                     f"{labels[i]}.position", a.position,
                     f"a position that does not overlap {labels[j]} (centre {b.position:g} m, "
-                    f"width {b.width:g} m) on bay {a.bay}, level {a.level}", source=source)
+                    f"width {b.width:g} m) on bay {a.bay}, level {a.level}"
+                    + (f", row {a.row}" if a.row > 1 else ""), source=source)
         earlier.append(i)

@@ -13,7 +13,9 @@ few lines instead of one ``[[pallets]]`` block each (keys, units and defaults in
 - with ``occupancy < 1`` exactly ``round(occupancy · n_slots)`` (half up) of the table's slots are
   loaded, chosen with ``numpy.random.default_rng(seed)``, so the same file gives the same rack;
 - order: by level (bottom to top), then bay (left to right); within a cell the explicit pallets in
-  input order, else the table's slots left to right.
+  input order, else the table's slots left to right;
+- a back-to-back rack (``[geometry] rows = 2``) has the cells of both rows: the table fills row 1
+  then row 2 (row outermost in the order above), and an explicit pallet's ``row`` names its cell.
 """
 
 from __future__ import annotations
@@ -109,33 +111,35 @@ def place_pallets(loading: Loading | None, geom: Geometry, explicit: Sequence[Pa
     labels = [f"pallets[{i}]" for i in range(len(explicit))]
     if loading is None:
         return tuple(explicit), tuple(labels)
-    by_cell: dict[tuple[int, int], list[int]] = {}
+    by_cell: dict[tuple[int, int, int], list[int]] = {}  # (row, level, bay) -> explicit
     for i, p in enumerate(explicit):
-        by_cell.setdefault((p.level, p.bay), []).append(i)
-    slots = [(level, bay, s) for level in loading.levels if loading.level_mass[level - 1] > 0
-             for bay in range(1, geom.n_bays + 1) if (level, bay) not in by_cell
-             for s in range(loading.pallets_per_bay)]
+        by_cell.setdefault((p.row, p.level, p.bay), []).append(i)
+    cells = [(row, level, bay) for row in range(1, geom.rows + 1)
+             for level in range(1, geom.n_levels + 1) for bay in range(1, geom.n_bays + 1)]
+    slots = [(*cell, s) for cell in cells
+             if cell[1] in loading.levels and loading.level_mass[cell[1] - 1] > 0
+             and cell not in by_cell for s in range(loading.pallets_per_bay)]
     loaded = _choose(len(slots), loading.occupancy, loading.seed)
-    generated: dict[tuple[int, int], list[Pallet]] = {}
+    generated: dict[tuple[int, int, int], list[Pallet]] = {}
     for k in loaded:
-        level, bay, s = slots[k]
+        row, level, bay, s = slots[k]
         position = slot_positions(loading, geom.bays[bay - 1])[s]
-        generated.setdefault((level, bay), []).append(Pallet(
+        generated.setdefault((row, level, bay), []).append(Pallet(
             mass=loading.level_mass[level - 1], bay=bay, level=level, position=position,
             mu_static=loading.mu_static, mu_dynamic=loading.mu_dynamic, width=loading.width,
-            sliding_limit=loading.sliding_limit, friction_rate=loading.friction_rate))
+            sliding_limit=loading.sliding_limit, friction_rate=loading.friction_rate,
+            row=row))
     pallets: list[Pallet] = []
     out_labels: list[str] = []
-    for level in range(1, geom.n_levels + 1):
-        for bay in range(1, geom.n_bays + 1):
-            if (level, bay) in by_cell:
-                for i in by_cell[(level, bay)]:
-                    pallets.append(explicit[i])
-                    out_labels.append(labels[i])
-            else:
-                cell = generated.get((level, bay), [])
-                pallets.extend(cell)
-                out_labels.extend(["loading"] * len(cell))
+    for cell in cells:
+        if cell in by_cell:
+            for i in by_cell[cell]:
+                pallets.append(explicit[i])
+                out_labels.append(labels[i])
+        else:
+            got = generated.get(cell, [])
+            pallets.extend(got)
+            out_labels.extend(["loading"] * len(got))
     return tuple(pallets), tuple(out_labels)
 
 

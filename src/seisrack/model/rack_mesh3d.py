@@ -1,126 +1,67 @@
-"""Geometry → 3D mesh of a rack: uprights, front and rear beams, bracing, DOF map and springs.
+"""Geometry → mesh of a space (3D) rack, a :class:`~seisrack.model.rack_mesh.RackMesh`:
+uprights, front and rear beams, bracing, row spacers, DOF map and springs.
 
-Global axes: x down-aisle (along the beams), y up, z cross-aisle; the front frame is the plane
-z = 0, the rear frame z = ``depth``. Six DOFs per node ``(ux, uy, uz, rx, ry, rz)``.
+Global axes: x down-aisle (along the beams), y up, z cross-aisle. A rack of one row has its
+front frame in the plane z = 0 and its rear frame at z = ``depth``; a back-to-back rack
+(``[geometry] rows = 2``) has row 2's frames at z = depth + length and 2·depth + length (length:
+the row spacers'), so four upright *sides* (0, 1: row 1 front and rear; 2, 3: row 2), given by
+:attr:`~seisrack.model.spec.Geometry.frame_z`. Six DOFs per node ``(ux, uy, uz, rx, ry, rz)``.
 
 - Uprights (beam-columns, ``vecxz`` = +z): local z = global z, so ``Iz`` (the 2D ``I``) is
   bending in the down-aisle plane and ``Iy`` cross-aisle bending. Nodes at the ``subdivisions``
-  divisions of every storey, at every panel point and at every bracing end (merged when within
-  1e-6 m).
-- Beams (``vecxz`` = +z): a front and a rear beam in every bay and level, stations as in 2D
-  (:func:`seisrack.model.rack_mesh.beam_stations`). A beam end is its own node sharing the
-  upright node's translations and its rotations rx, ry (rigid in those directions) and, for a
-  semi-rigid or pinned connector, owning its rotation rz about the cross-aisle axis, tied to
-  the upright's by a spring (none for pinned); a rigid connector shares rz too.
+  divisions of every storey, at every panel point, every bracing end and every row spacer
+  (merged when within 1e-6 m).
+- Beams (``vecxz`` = +z): one per side in every bay and level (a front and a rear beam per
+  row), stations as in 2D (:func:`seisrack.model.rack_mesh.beam_stations`; every beam of a bay
+  and level has the same stations, from the pallets of both rows). A beam end is its own node
+  sharing the upright node's translations and its rotations rx, ry (rigid in those directions)
+  and, for a semi-rigid or pinned connector, owning its rotation rz about the cross-aisle axis,
+  tied to the upright's by a spring (none for pinned); a rigid connector shares rz too.
 - Bases: translations and the twist ry fixed; rz (down-aisle bending) and rx (cross-aisle
   bending) each fixed (rigid), free with a spring to the ground (semi-rigid: ``base`` and
   ``base_cross``) or free (pinned).
-- Bracing: pin-ended bars (3D trusses) between upright nodes of each upright frame, and the
-  spine diagonals in the rear plane; eccentricities ignored.
+- Bracing: pin-ended bars (3D trusses) between upright nodes of each upright frame, the same in
+  each row (F its front, R its rear upright), and the spine diagonals in each row's back plane
+  (the rear frame of row 1, the front frame of row 2: the faces on the flue, the aisle faces
+  being the loading faces); eccentricities ignored.
+- Row spacers (back-to-back racks): pin-ended bars joining the inner uprights of the two rows
+  (sides 1 and 2) on every upright line at the spacer heights; eccentricities ignored.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
-from seisrack.fe.mesh import FloatArray, IntArray
+from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.model.bracing import FRONT
-from seisrack.model.rack_mesh import beam_stations
+from seisrack.model.rack_mesh import (
+    BEAM,
+    BRACING,
+    SPACER,
+    SPINE,
+    UPRIGHT,
+    RackMesh,
+    beam_stations,
+)
 from seisrack.model.spec import RackSpec
 
-UPRIGHT, BEAM, BRACING, SPINE = 0, 1, 2, 3
 _Z_AXIS = (0.0, 0.0, 1.0)
 _MERGE = 1e-6  # m
 
 
-@dataclass(frozen=True)
-class Mesh3D:
-    """Array description of a 3D frame (beam-columns, trusses and rotational springs).
-
-    nodes: (n_node, 3) [m]; node_dofs: (n_node, 6) int, -1 = restrained.
-    elements: (n_el, 2) beam-column node pairs with E, G, A, Iy, Iz, J, Ip, density (n_el,) and
-    vecxz (n_el, 3). trusses: (n_tr, 2) node pairs with truss_E, truss_A, truss_density.
-    springs: (n_s, 2) DOF pairs (-1 = ground), spring_k (n_s,) [N·m/rad].
-    """
-
-    nodes: FloatArray
-    node_dofs: IntArray
-    elements: IntArray
-    E: FloatArray
-    G: FloatArray
-    A: FloatArray
-    Iy: FloatArray
-    Iz: FloatArray
-    J: FloatArray
-    Ip: FloatArray
-    density: FloatArray
-    vecxz: FloatArray
-    trusses: IntArray
-    truss_E: FloatArray
-    truss_A: FloatArray
-    truss_density: FloatArray
-    springs: IntArray
-    spring_k: FloatArray
-    n_dof: int
-
-    def __getattr__(self, name: str) -> Any:
-        # 2D-only mesh attributes (I, direction_cosines, ...): a clear InputError for 2D code
-        # handed a 3D rack (e.g. the OpenSees export), not a traceback.
-        if name in ("I", "direction_cosines", "ground_spring_k", "n_el"):
-            from seisrack.model.dimension import require_2d
-
-            require_2d(self, depth=float(np.ptp(self.nodes[:, 2])))
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
-    @property
-    def element_dofs(self) -> IntArray:
-        """(n_el, 12) global DOFs of each beam-column; -1 fixed."""
-        return self.node_dofs[self.elements].reshape(-1, 12)
-
-    @property
-    def truss_dofs(self) -> IntArray:
-        """(n_tr, 6) translation DOFs of each truss; -1 fixed."""
-        return self.node_dofs[self.trusses][:, :, :3].reshape(-1, 6)
-
-    @property
-    def lengths(self) -> FloatArray:
-        d = self.nodes[self.elements[:, 1]] - self.nodes[self.elements[:, 0]]
-        return np.linalg.norm(d, axis=1)
-
-
-@dataclass(frozen=True)
-class RackMesh3D:
-    """The mesh plus the rack bookkeeping the 3D compiler needs.
-
-    ``side`` 0 = front (z = 0), 1 = rear (z = depth). Upright line c, side s is column
-    ``2 c + s``. ``truss_kind``: BRACING or SPINE; ``truss_line``: upright line (bracing) or
-    bay (spine).
-    """
-
-    mesh: Mesh3D
-    element_kind: IntArray
-    element_storey: IntArray
-    element_line: IntArray
-    element_side: IntArray
-    truss_kind: IntArray
-    truss_line: IntArray
-    base_nodes: IntArray  # (n_line, 2)
-    level_nodes: IntArray  # (n_line, 2, n_level)
-    beam_nodes: dict[tuple[int, int, int], IntArray]  # (level, bay, side) -> nodes
-    beam_stations: dict[tuple[int, int], FloatArray]  # (level, bay) -> x from left upright
-
-
 def _upright_heights(spec: RackSpec) -> FloatArray:
+    """Heights of the upright nodes: storey divisions, panel points, bracing ends and row
+    spacers."""
     geo = spec.geometry
     ys = (0.0, *geo.level_y)
     pts = [float(y) for s in range(geo.n_levels)
            for y in np.linspace(ys[s], ys[s + 1], geo.subdivisions + 1)]
     assert spec.bracing is not None
     pts += list(spec.bracing.heights)
+    if geo.row_spacer is not None:
+        pts += list(geo.row_spacer.heights)
     out: list[float] = []
     for y in sorted(pts):
         if not out or y - out[-1] > _MERGE:
@@ -128,11 +69,12 @@ def _upright_heights(spec: RackSpec) -> FloatArray:
     return np.array(out)
 
 
-def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
+def build_rack_mesh_3d(spec: RackSpec) -> RackMesh:
     geo, br = spec.geometry, spec.bracing
     assert geo.depth is not None and br is not None
     n_lev, n_line = geo.n_levels, geo.n_bays + 1
-    xs, zs = geo.upright_x, (0.0, geo.depth)
+    xs, zs = geo.upright_x, geo.frame_z
+    n_side = len(zs)  # 2 per row
     k_joint = spec.connections.beam_to_upright
     k_base, k_cross = spec.connections.base, spec.connections.base_cross_k
     heights = _upright_heights(spec)
@@ -151,9 +93,13 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
     el: list[tuple[int, int]] = []
     props: list[tuple[str, int, int, int, int]] = []  # section, kind, storey, line, side
     springs: list[tuple[int, int, float]] = []
-    base_nodes = np.zeros((n_line, 2), dtype=np.int64)
-    level_nodes = np.zeros((n_line, 2, n_lev), dtype=np.int64)
-    at_height: dict[tuple[int, int], IntArray] = {}  # (line, side) -> node per height
+    n_col = n_side * n_line  # column n_side·line + side
+    base_nodes = np.zeros(n_col, dtype=np.int64)
+    level_nodes = np.zeros((n_col, n_lev), dtype=np.int64)
+    base_el = np.zeros(n_col, dtype=np.int64)
+    below = np.zeros((n_col, n_lev), dtype=np.int64)
+    above = np.full((n_col, n_lev), -1, dtype=np.int64)
+    at_height: dict[tuple[int, int], np.ndarray] = {}  # (line, side) -> node per height
 
     def base_rot(k: float) -> int:
         if math.isinf(k):
@@ -165,10 +111,12 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
 
     for c, x in enumerate(xs):
         for side, z in enumerate(zs):
+            col = n_side * c + side
             ids = [len(nodes)]
-            base_nodes[c, side] = ids[0]
+            base_nodes[col] = ids[0]
             nodes.append((x, 0.0, z))
             dofs.append([-1, -1, -1, base_rot(k_cross), -1, base_rot(k_base)])
+            first = len(el)
             for y in heights[1:]:
                 ids.append(len(nodes))
                 nodes.append((x, float(y), z))
@@ -177,13 +125,18 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
                 el.append((ids[-2], ids[-1]))
                 props.append((geo.upright_sections[storey], UPRIGHT, storey, c, side))
             at_height[(c, side)] = np.array(ids, dtype=np.int64)
+            base_el[col] = first
             for lev, y in enumerate(level_y):
-                level_nodes[c, side, lev] = ids[int(np.argmin(np.abs(heights - y)))]
+                k = int(np.argmin(np.abs(heights - y)))  # node k ends element first + k - 1
+                level_nodes[col, lev] = ids[k]
+                below[col, lev] = first + k - 1
+                if k < len(heights) - 1:
+                    above[col, lev] = first + k
 
     by_member: dict[tuple[int, int], list[float]] = {}
     for p in spec.pallets:
         by_member.setdefault((p.level - 1, p.bay - 1), []).append(p.position)
-    b_nodes: dict[tuple[int, int, int], IntArray] = {}
+    b_nodes: dict[tuple[int, int, int], np.ndarray] = {}
     b_st: dict[tuple[int, int], FloatArray] = {}
     for lev in range(n_lev):
         for bay, span in enumerate(geo.bays):
@@ -195,7 +148,7 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
                     node = len(nodes)
                     nodes.append((xs[bay] + float(sx), float(level_y[lev]), z))
                     if i in (0, len(st) - 1):
-                        up = dofs[level_nodes[bay + (i > 0), side, lev]]
+                        up = dofs[level_nodes[n_side * (bay + (i > 0)) + side, lev]]
                         if math.isinf(k_joint):
                             dofs.append(list(up))
                         else:
@@ -217,17 +170,24 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
     def node_at(c: int, side: int, y: float) -> int:
         return int(at_height[(c, side)][int(np.argmin(np.abs(heights - y)))])
 
-    for c in range(n_line):
-        for (sa, ya, sb, yb), sec in zip(br.members, br.sections, strict=True):
-            tr.append((node_at(c, sa, ya), node_at(c, sb, yb)))
-            tr_props.append((sec, BRACING, c))
-    rear = 1 - FRONT
+    rows = n_side // 2
+    for r in range(rows):  # each row's upright frames braced alike (F: side 2r, R: 2r + 1)
+        for c in range(n_line):
+            for (sa, ya, sb, yb), sec in zip(br.members, br.sections, strict=True):
+                tr.append((node_at(c, 2 * r + sa, ya), node_at(c, 2 * r + sb, yb)))
+                tr_props.append((sec, BRACING, c))
     ys = np.concatenate([[0.0], level_y])
-    for bay in br.spine_bays:
-        for s in br.spine_levels:
-            lo, hi = (bay, bay + 1) if s % 2 == 0 else (bay + 1, bay)
-            tr.append((node_at(lo, rear, ys[s]), node_at(hi, rear, ys[s + 1])))
-            tr_props.append((br.spine_section or "", SPINE, bay))
+    for back in (1 - FRONT, 2)[:rows]:  # each row's back plane: the faces on the flue
+        for bay in br.spine_bays:
+            for s in br.spine_levels:
+                lo, hi = (bay, bay + 1) if s % 2 == 0 else (bay + 1, bay)
+                tr.append((node_at(lo, back, ys[s]), node_at(hi, back, ys[s + 1])))
+                tr_props.append((br.spine_section or "", SPINE, bay))
+    if geo.row_spacer is not None:  # row 1's rear uprights to row 2's front uprights
+        for c in range(n_line):
+            for y in geo.row_spacer.heights:
+                tr.append((node_at(c, 1, y), node_at(c, 2, y)))
+                tr_props.append((geo.row_spacer.section, SPACER, c))
 
     secs = spec.sections
     n_el = len(el)
@@ -236,10 +196,10 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
                      s.Ip if s.Ip is not None else (s.Iy or 0.0) + s.I) for s in sec_of],
                    dtype=float).reshape(n_el, 5)
     mat = spec.material
-    mesh = Mesh3D(
+    mesh = FrameMesh(
         nodes=np.array(nodes, dtype=float), node_dofs=np.array(dofs, dtype=np.int64),
         elements=np.array(el, dtype=np.int64).reshape(-1, 2), E=np.full(n_el, mat.E),
-        G=np.full(n_el, mat.G), A=col[:, 0].copy(), Iy=col[:, 1].copy(), Iz=col[:, 2].copy(),
+        G=np.full(n_el, mat.G), A=col[:, 0].copy(), Iy=col[:, 1].copy(), I=col[:, 2].copy(),
         J=col[:, 3].copy(), Ip=col[:, 4].copy(), density=np.full(n_el, mat.density),
         vecxz=np.tile(np.array(_Z_AXIS), (n_el, 1)),
         trusses=np.array(tr, dtype=np.int64).reshape(-1, 2), truss_E=np.full(len(tr), mat.E),
@@ -249,8 +209,11 @@ def build_rack_mesh_3d(spec: RackSpec) -> RackMesh3D:
         spring_k=np.array([s[2] for s in springs], dtype=float), n_dof=n_dof)
     arr = np.array([p[1:] for p in props], dtype=np.int64).reshape(-1, 4)
     tarr = np.array([p[1:] for p in tr_props], dtype=np.int64).reshape(-1, 2)
-    return RackMesh3D(mesh=mesh, element_kind=arr[:, 0].copy(),
-                      element_storey=arr[:, 1].copy(), element_line=arr[:, 2].copy(),
-                      element_side=arr[:, 3].copy(), truss_kind=tarr[:, 0].copy(),
-                      truss_line=tarr[:, 1].copy(), base_nodes=base_nodes,
-                      level_nodes=level_nodes, beam_nodes=b_nodes, beam_stations=b_st)
+    return RackMesh(mesh=mesh, element_kind=arr[:, 0].copy(), element_storey=arr[:, 1].copy(),
+                    element_line=arr[:, 2].copy(), element_side=arr[:, 3].copy(),
+                    truss_kind=tarr[:, 0].copy(), truss_line=tarr[:, 1].copy(),
+                    column_line=np.repeat(np.arange(n_line, dtype=np.int64), n_side),
+                    column_side=np.tile(np.arange(n_side, dtype=np.int64), n_line),
+                    base_nodes=base_nodes, level_nodes=level_nodes, upright_base_elements=base_el,
+                    upright_below_elements=below, upright_above_elements=above,
+                    beam_nodes=b_nodes, beam_stations=b_st)

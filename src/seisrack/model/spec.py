@@ -65,11 +65,25 @@ class Section:
 
 
 @dataclass(frozen=True)
+class RowSpacer:
+    """The row spacers of a back-to-back (double-entry) rack: pin-ended bars of section
+    ``section`` joining the inner uprights of the two rows (rear upright of row 1, front
+    upright of row 2) on every upright line, at ``heights`` [m] above the floor; ``length``
+    [m] is the flue between the two inner frames (upright centrelines), the bars' length."""
+
+    length: float
+    section: str
+    heights: tuple[float, ...]
+
+
+@dataclass(frozen=True)
 class Geometry:
     """Bays (spans, left to right) and levels (storey heights, bottom to top).
 
     ``beam_sections[k]`` is the section name of the beams of level ``k`` (0-based) and
-    ``upright_sections[k]`` that of the uprights of storey ``k``.
+    ``upright_sections[k]`` that of the uprights of storey ``k``. A 3D rack (``depth``) has one
+    row of upright frames or, ``rows = 2``, two back to back joined by ``row_spacer``: row 1's
+    frames at z = 0 and ``depth``, row 2's at z = depth + length and 2 depth + length.
     """
 
     bays: tuple[float, ...]
@@ -78,6 +92,20 @@ class Geometry:
     upright_sections: tuple[str, ...]
     subdivisions: int = DEFAULT_SUBDIVISIONS
     depth: float | None = None  # upright-frame depth [m]: a 3D rack when given
+    rows: int = 1
+    row_spacer: RowSpacer | None = None
+
+    @property
+    def frame_z(self) -> tuple[float, ...]:
+        """z [m] of each upright frame (front to rear: 2·rows frames in 3D, (0.0,) in 2D)."""
+        if self.depth is None:
+            return (0.0,)
+        d = float(self.depth)
+        if self.rows == 1:
+            return (0.0, d)
+        assert self.row_spacer is not None  # the loader requires it with rows = 2
+        s = float(self.row_spacer.length)
+        return (0.0, d, d + s, 2 * d + s)
 
     @property
     def n_bays(self) -> int:
@@ -173,11 +201,12 @@ class Hysteresis:
 
 @dataclass(frozen=True)
 class Pallet:
-    """A pallet resting on the beams of one bay and level.
+    """A pallet resting on the beams of one bay and level (and row, 1-based).
 
-    ``bay`` and ``level`` are 1-based (as in the TOML). ``position`` [m] is the pallet centre from
-    the left upright of its bay; ``width`` [m] its extent along the beam. ``sliding_limit`` [m] is
-    the allowed sliding on each side, or ``None`` for the free distance to the next obstacle.
+    ``bay``, ``level`` and ``row`` are 1-based (as in the TOML). ``position`` [m] is the pallet
+    centre from the left upright of its bay; ``width`` [m] its extent along the beam.
+    ``sliding_limit`` [m] is the allowed sliding on each side, or ``None`` for the free distance
+    to the next obstacle.
     ``friction_rate`` [s/m]: 0 for Coulomb friction, else velocity-dependent sliding friction
     mu(v) = mu_dynamic + (mu_static - mu_dynamic) exp(-rate |v|) (see Sliders).
     """
@@ -193,6 +222,7 @@ class Pallet:
     friction_rate: float = 0.0
     depth: float | None = None  # 3D racks: pallet depth cross-aisle [m]
     overhang: float | None = None  # 3D racks: overhang beyond the front and rear beams [m]
+    row: int = 1  # back-to-back racks: the row (1 front, 2 rear) whose two beams it rests on
 
 
 @dataclass(frozen=True)
@@ -213,9 +243,10 @@ class RackSpec:
     bracing: Bracing | None = None  # 3D racks (geometry.depth given)
 
     @property
-    def is_3d(self) -> bool:
-        """True when ``[geometry] depth`` is given: a 3D rack (see ``compile_rack_3d``)."""
-        return self.geometry.depth is not None
+    def ndm(self) -> int:
+        """The rack's dimension: 3 when ``[geometry] depth`` is given (a space frame with
+        upright frames and bracing), else 2 (a plane frame)."""
+        return 2 if self.geometry.depth is None else 3
 
     def beam_section(self, level: int) -> Section:
         """Section of the beams of 0-based ``level``."""

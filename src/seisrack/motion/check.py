@@ -125,7 +125,7 @@ def _declares_units(path: Path) -> bool:
     """True for a ``.AT2`` file (g) or a seisrack CSV whose header gives m/s²."""
     if path.suffix.lower() == ".at2":
         return True
-    with path.open(encoding="utf-8", errors="replace") as fh:
+    with path.open(encoding="utf-8-sig", errors="replace") as fh:
         first = fh.readline()
     return first.strip().replace(" ", "").lower() == _HEADER
 

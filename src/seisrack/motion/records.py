@@ -229,7 +229,7 @@ def read_record(
     """
     p = Path(path)
     dt = _check_dt(dt)
-    text = p.read_text(encoding="utf-8", errors="replace")
+    text = p.read_text(encoding="utf-8-sig", errors="replace")  # Excel, Notepad: a BOM
     lines = text.splitlines()
     spath = str(p)
     if p.suffix.lower() == ".at2":
@@ -251,10 +251,11 @@ def write_record_csv(record: Record, path: str | Path) -> Path:
 
     Returns the path written. Read it back with ``read_record(path)`` (units from the header).
     """
-    p = Path(path)
+    from seisrack.atomic import atomic_write
+
     data = np.column_stack([record.time, record.accel])
-    np.savetxt(p, data, delimiter=",", header=_HEADER, comments="", fmt="%.10g")
-    return p
+    return atomic_write(path, lambda p: np.savetxt(p, data, delimiter=",", header=_HEADER,
+                                                   comments="", fmt="%.10g"))
 
 
 # name -> (file, units, dt [s], description)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.motion.records import G as G_REC
 from seisrack.paper import values as pv
 from seisrack.paper.rack import RackRun, RackStudy, table_row
@@ -36,7 +37,7 @@ def save_fig15(st: RackStudy, path: Path) -> Path:
     ax_b.set_title("(b) response spectrum of the record and EC8 target (η = 5 %)", fontsize=10)
     ax_b.legend(fontsize="small")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -72,7 +73,7 @@ def save_fig16(rs: RackRun, path: Path, title: str) -> Path:
             ax.set_xlabel("")
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path
 
@@ -127,6 +128,6 @@ def save_physics_figure(st: RackStudy, path: Path) -> Path:
     ax_b.legend(fontsize="small", loc="upper left")
     ax_b.grid(True, alpha=0.3)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path

@@ -195,5 +195,7 @@ def reproduce_paper(
                       parallel=futures is not None)
     rep.seconds = time.perf_counter() - t_all
     text = "\n\n".join([_header(rep), *(_section_md(s) for s in sections), _DOUBTS])
-    rep.report.write_text(text, encoding="utf-8")
+    from seisrack.atomic import write_text
+
+    write_text(rep.report, text)
     return rep

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.paper import values as pv
 from seisrack.paper.sections import Check, Figure, Section, md_table, pyplot
 from seisrack.sdof.closed_form import SdofSolution, solve_sdof
@@ -67,7 +68,7 @@ def _fig5(sols: dict[float, SdofSolution], path: Path) -> Path:
                        fontsize=10)
         ax_v.set_xlabel("")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -106,7 +107,7 @@ def _fig6(ratios: np.ndarray, states: np.ndarray, n_cycles: float, thr: float, p
                        zip(_STATE_COLORS, ("sliding −", "stuck", "sliding +"), strict=True)],
               loc="upper left", fontsize="small", framealpha=0.9)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return path
 
@@ -132,7 +133,7 @@ def _fig7(sols: dict[float, SdofSolution], path: Path) -> Path:
         axes[0, col].set_title(f"case {'ABC'[col]}: μ/α = {ratio:g}", fontsize=10)
         axes[-1, col].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path
 

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.dynamics import simulate
 from seisrack.dynamics.reference import simulate_reference
 from seisrack.paper.examples import ValidationExample, examples, run_engine
@@ -92,7 +93,7 @@ def _fig11(rows: list[dict[str, Any]], path: Path) -> Path:
     ax.set_xlabel("time [s]")
     ax.legend(loc="upper left", fontsize="x-small", ncol=3)
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path
 
@@ -112,7 +113,7 @@ def _fig12(rows: list[dict[str, Any]], path: Path) -> Path:
     axes[0, 0].legend(loc="upper left", fontsize="x-small", ncol=2)
     axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    save_figure(fig, path, dpi=100)
     plt.close(fig)
     return path
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from seisrack.atomic import save_figure
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -78,7 +80,7 @@ def save_validation_figures(results: dict[str, dict[str, Any]], out_dir: Path) -
         axes[0].set_title(name)
         fig.tight_layout()
         p = out_dir / f"{name}.png"
-        fig.savefig(p, dpi=110)
+        save_figure(fig, p, dpi=110)
         plt.close(fig)
         paths.append(p)
     return paths

@@ -14,7 +14,7 @@ import numpy as np
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-__all__ = ["plot_fragility", "plot_ida"]
+__all__ = ["DRAWN_STATUSES", "fit_is_drawable", "plot_fragility", "plot_ida"]
 
 
 def _axes(ax: Any) -> Any:
@@ -29,6 +29,17 @@ def _axes(ax: Any) -> Any:
     return ax
 
 
+#: fit statuses whose (theta, beta) describe a curve worth drawing
+DRAWN_STATUSES = ("ok", "ida_moments", "ida_censored")
+
+
+def fit_is_drawable(theta: float, beta: float, status: str | None = None) -> bool:
+    """Whether a lognormal curve can honestly be drawn for this fit: a finite θ > 0 and
+    β > 0, and a status that describes a curve (not "separated", "underdetermined", ...)."""
+    return (status is None or status in DRAWN_STATUSES) and bool(
+        np.isfinite(theta) and theta > 0 and np.isfinite(beta) and beta > 0)
+
+
 def plot_fragility(
     im: Sequence[float],
     fraction: Sequence[float],
@@ -39,30 +50,50 @@ def plot_fragility(
     grid: np.ndarray | None = None,
     label: str = "",
     im_label: str = "IM [m/s²]",
+    status: str | None = None,
     ax: Axes | None = None,
 ) -> Axes:
     """Observed fraction exceeding per stripe (markers), fitted lognormal, optional band.
 
     im, fraction: (m,) stripe intensity [IM units] and fraction of runs exceeding [-];
-    band: (lo, hi) on ``grid`` (pointwise bootstrap percentiles).
+    band: (lo, hi) on ``grid`` (pointwise bootstrap percentiles); status: the fit's status
+    (:class:`seisrack.studies.fragility.FragilityFit`). A fit that describes no curve
+    ("separated": a step with β undetermined, "underdetermined", "failed", ...) is not drawn
+    as one: the observed fractions are joined by a dashed line and the legend says why, and
+    for a step its θ is marked (a step drawn to probability 1 would contradict a stripe
+    observed at, say, 0.33).
     """
     from seisrack.lognormal import fragility_curve
 
     ax = _axes(ax)
     im = np.asarray(im, dtype=float)
+    frac = np.asarray(fraction, dtype=float)
     if grid is None:
         top = max(float(np.max(im)) if im.size else 1.0, theta if np.isfinite(theta) else 0.0)
         grid = np.linspace(0.0, 1.5 * top, 200)[1:]
-    (line,) = ax.plot(grid, fragility_curve(grid, theta, beta), label=label or None)
-    c = line.get_color()
-    if band is not None and np.all(np.isfinite(band[0])):
-        ax.fill_between(grid, band[0], band[1], color=c, alpha=0.2, lw=0)
-    ax.plot(im, fraction, "o", color=c, mfc="none")
+    if fit_is_drawable(theta, beta, status):
+        (line,) = ax.plot(grid, fragility_curve(grid, theta, beta), label=label or None)
+        c = line.get_color()
+        if band is not None and np.all(np.isfinite(band[0])):
+            ax.fill_between(grid, band[0], band[1], color=c, alpha=0.2, lw=0)
+        ax.plot(im, frac, "o", color=c, mfc="none")
+    else:
+        order = np.argsort(im)
+        good = order[np.isfinite(frac[order])]
+        why = {"separated": "fit separated: a step, β undetermined",
+               "underdetermined": "fit underdetermined: θ and β not both estimable"}.get(
+            status or "", f"no fitted curve ({status or 'no fit'})")
+        name = label.removesuffix(": fitted") if label else ""
+        (line,) = ax.plot(im[good], frac[good], "o--", mfc="none", lw=1,
+                          label=f"{name + ': ' if name else ''}observed; {why}")
+        if status == "separated" and np.isfinite(theta) and theta > 0:
+            ax.axvline(theta, color=line.get_color(), ls=":", lw=1,
+                       label=f"θ ≈ {theta:.3g} (where the step lies)")
     ax.set_xlabel(im_label)
     ax.set_ylabel("P(exceed) [-]")
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlim(left=0.0)
-    if label:
+    if label or ax.get_legend_handles_labels()[0]:
         ax.legend(loc="best", fontsize="small")
     return ax
 

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.fe.elements import rotation
 from seisrack.fe.mesh import FloatArray
 
@@ -58,7 +59,7 @@ def plot_frame(model: Any, ax: Any = None, *, color: str = "0.6", show_pallets: 
     base = mesh.nodes[model.base_nodes]
     ax.plot(base[:, 0], base[:, 1], "k^", ms=8, clip_on=False)
     if show_pallets and model.n_pallets:
-        p = mesh.nodes[model.pallet_node]
+        p = mesh.nodes[model.pallet_node[:, 0]]
         ax.plot(p[:, 0], p[:, 1], "s", color="tab:orange", ms=7, label="pallets")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
@@ -68,10 +69,15 @@ def plot_frame(model: Any, ax: Any = None, *, color: str = "0.6", show_pallets: 
 
 def plot_mode_shape(model: Any, modal: Any, mode: int = 1, ax: Any = None, *,
                     scale: float | None = None, color: str = "tab:blue") -> Any:
-    """Draw mode ``mode`` (1-based) over the undeformed frame.
+    """Draw mode ``mode`` (1-based) over the undeformed frame (a 3D rack on 3D axes:
+    :func:`seisrack.report.frame_plot3d.plot_mode_shape_3d`).
 
     ``scale=None`` sets the largest nodal translation to 15 % of the frame's size.
     """
+    if model.ndm == 3:
+        from seisrack.report.frame_plot3d import plot_mode_shape_3d
+
+        return plot_mode_shape_3d(model, modal, mode, ax, scale=scale, color=color)
     ax = plot_frame(model, ax, show_pallets=False)
     phi = modal.shapes[:, mode - 1]
     mesh = model.mesh
@@ -86,6 +92,28 @@ def plot_mode_shape(model: Any, modal: Any, mode: int = 1, ax: Any = None, *,
     return ax
 
 
+def modes_figure(model: Any, modal: Any, n_shapes: int = 3, *, frame: bool = False) -> Any:
+    """A figure with the first ``n_shapes`` mode shapes (3D axes for a 3D rack) and, with
+    ``frame`` on a plane rack, the undeformed rack first. Returns the Figure."""
+    import matplotlib.pyplot as plt
+
+    n = max(1, min(n_shapes, modal.n_modes))
+    frame = frame and model.ndm == 2
+    panels = n + frame
+    fig = plt.figure(figsize=(4.2 * panels, 4.2 if model.ndm == 3 else 4.0))
+    proj = "3d" if model.ndm == 3 else None
+    if frame:
+        ax = fig.add_subplot(1, panels, 1)
+        plot_frame(model, ax)
+        ax.set_title(model.title or "rack", fontsize=9)
+    for k in range(n):
+        ax = plot_mode_shape(model, modal, k + 1,
+                             fig.add_subplot(1, panels, k + 1 + frame, projection=proj))
+        ax.title.set_fontsize(8)
+    fig.tight_layout()
+    return fig
+
+
 def save_modes_figure(model: Any, modal: Any, path: str | Path, n_shapes: int = 3) -> Path:
     """Write a PNG with the undeformed rack and the first ``n_shapes`` mode shapes (Agg)."""
     import matplotlib
@@ -93,14 +121,8 @@ def save_modes_figure(model: Any, modal: Any, path: str | Path, n_shapes: int = 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    n = max(1, min(n_shapes, modal.n_modes))
-    fig, axes = plt.subplots(1, n + 1, figsize=(4.2 * (n + 1), 4.0), squeeze=False)
-    plot_frame(model, axes[0, 0])
-    axes[0, 0].set_title(model.title or "rack", fontsize=9)
-    for k in range(n):
-        plot_mode_shape(model, modal, k + 1, axes[0, k + 1])
-    fig.tight_layout()
+    fig = modes_figure(model, modal, n_shapes, frame=True)
     out = Path(path)
-    fig.savefig(out, dpi=120)
+    save_figure(fig, out, dpi=120)
     plt.close(fig)
     return out

@@ -8,7 +8,6 @@ cross-aisle, y up (drawn as matplotlib's vertical axis).
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -73,21 +72,3 @@ def plot_mode_shape_3d(model: Any, modal: Any, mode: int = 1, ax: Any = None, *,
         label = f", {modal.direction[mode - 1]}"
     ax.set_title(f"mode {mode}: T = {modal.periods[mode - 1]:.3f} s{label}", fontsize=9)
     return ax
-
-
-def save_modes_figure_3d(model: Any, modal: Any, path: str | Path, n_shapes: int = 3) -> Path:
-    """Write a PNG with the first ``n_shapes`` mode shapes of a 3D rack (Agg)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    n = max(1, min(n_shapes, modal.n_modes))
-    fig = plt.figure(figsize=(4.2 * n, 4.2))
-    for k in range(n):
-        plot_mode_shape_3d(model, modal, k + 1, fig.add_subplot(1, n, k + 1, projection="3d"))
-    fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
-    return out

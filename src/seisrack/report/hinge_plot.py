@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.errors import InputError
 
 
@@ -150,6 +151,6 @@ def save_hinge_figures(resp: Any, out_dir: Any, *, suptitle: str | None = None) 
         return []
     fig = hinge_loops_figure(resp.hinges, title=suptitle)
     path = Path(out_dir) / HINGE_FIGURES[0]
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return [path]

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
 from seisrack.motion.records import G, Record
 
 
@@ -66,5 +67,5 @@ def save(ax: Any, path: str) -> None:
 
     fig = ax.figure
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)

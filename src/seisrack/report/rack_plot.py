@@ -1,4 +1,4 @@
-"""Figures of a rack time history, like the paper's Fig. 16a–d (§IV.B).
+"""Figures of a rack time history (2D or 3D), like the paper's Fig. 16a–d (§IV.B).
 
 Fig. 16a: horizontal displacement of the beam (relative to the ground); 16b: horizontal
 (absolute) acceleration of the beam; 16c: total horizontal contact force between the beam and
@@ -220,9 +220,12 @@ FIG16_FILES = tuple(f"{_QUANTITIES[k][5]}.png" for k in FIG16)
 
 
 # ------------------------------------------------------------------ the user's rack (issue 14)
-#: file names written by :func:`save_rack_figures`, named after what they show
+#: file names written by :func:`save_rack_figures`, named after what they show (a rack with
+#: two horizontal directions adds the plan view ``sliding_paths.png``)
 RACK_FIGURES = ("beam_displacement.png", "beam_acceleration.png", "contact_force.png",
                 "pallet_sliding.png", "sliding_heatmap.png")
+#: the directions' names in titles
+_DIRECTION_TITLE = ("down-aisle", "cross-aisle")
 
 
 def _level_colours(n: int) -> list[Any]:
@@ -244,9 +247,11 @@ def _level_legend_or_bar(ax: Any, n: int, max_legend: int = 8) -> None:
     ax.figure.colorbar(sm, ax=ax, label="beam level", ticks=range(1, n + 1, max(1, n // 10)))
 
 
-def plot_levels(resp: RackResponse, quantity: str, ax: Any = None) -> Any:
+def plot_levels(resp: RackResponse, quantity: str, ax: Any = None, *, direction: int = 0
+                ) -> Any:
     """A per-level history (``beam_displacement``, ``beam_acceleration`` (raw) or
-    ``beam_acceleration_filtered``, ``contact_force``) of every level, coloured by level."""
+    ``beam_acceleration_filtered``, ``contact_force``) of every level along ``direction``
+    (0 down-aisle, 1 cross-aisle), coloured by level."""
     ax = _axes(ax)
     scale, unit, title = {
         "beam_displacement": (1e3, "beam displacement [mm]",
@@ -261,8 +266,10 @@ def plot_levels(resp: RackResponse, quantity: str, ax: Any = None) -> Any:
         "contact_force": (1e-3, "contact force [kN]",
                           "Horizontal contact force of the beams on the pallets, per level"),
     }[quantity]
-    arr = getattr(resp, quantity)
+    arr = resp.directional(quantity)[..., direction]
     n = arr.shape[1]
+    if resp.n_dir > 1:
+        title = f"{title} [{_DIRECTION_TITLE[direction]}]"
     for lv, c in enumerate(_level_colours(n)):
         ax.plot(resp.t, arr[:, lv] * scale, lw=0.7, color=c, label=f"level {lv + 1}")
     ax.set_xlabel("time [s]")
@@ -274,24 +281,31 @@ def plot_levels(resp: RackResponse, quantity: str, ax: Any = None) -> Any:
     return ax
 
 
-def plot_all_pallet_sliding(resp: RackResponse, ax: Any = None) -> Any:
-    """Sliding history of every pallet, coloured by its level (a colour bar, no legend)."""
+def plot_all_pallet_sliding(resp: RackResponse, ax: Any = None, *, direction: int = 0) -> Any:
+    """Sliding history of every pallet along ``direction``, coloured by its level (a colour
+    bar, no legend), with the smallest free distance (down-aisle) or the smallest fall limits
+    (cross-aisle) dashed."""
     ax = _axes(ax)
     n = resp.beam_displacement.shape[1]
     cols = _level_colours(n)
+    sliding = resp.directional("pallet_sliding")[..., direction]
     for j in range(resp.n_pallets):
-        ax.plot(resp.t, resp.pallet_sliding[:, j] * 1e3, lw=0.6,
-                color=cols[int(resp.pallet_level[j])],
+        ax.plot(resp.t, sliding[:, j] * 1e3, lw=0.6, color=cols[int(resp.pallet_level[j])],
                 label=f"level {int(resp.pallet_level[j]) + 1}")
-    lim_p = float(np.min(resp.pallet_limit_pos, initial=np.inf))
-    lim_n = float(np.min(resp.pallet_limit_neg, initial=np.inf))
+    pos, neg = ((resp.pallet_limit_pos, resp.pallet_limit_neg) if direction == 0 else
+                (resp.fall_rear, resp.fall_front))
+    lim_p = float(np.nanmin(pos, initial=np.inf))
+    lim_n = float(np.nanmin(neg, initial=np.inf))
     if np.isfinite(lim_p) and np.isfinite(lim_n):
         ax.axhline(lim_p * 1e3, color="r", ls="--", lw=0.7)
         ax.axhline(-lim_n * 1e3, color="r", ls="--", lw=0.7)
     ax.set_xlabel("time [s]")
     ax.set_ylabel("pallet sliding [mm]")
-    ax.set_title(f"Sliding of the {resp.n_pallets} pallets relative to their beams, coloured "
-                 "by level\ndashed: smallest free distance before a pallet falls", fontsize=10)
+    what = ("smallest free distance (neighbour or upright)" if direction == 0 else
+            "smallest fall limits (front -, rear +)")
+    where = f" [{_DIRECTION_TITLE[direction]}]" if resp.n_dir > 1 else ""
+    ax.set_title(f"Sliding of the {resp.n_pallets} pallets relative to their beams{where}, "
+                 f"coloured by level\ndashed: {what}", fontsize=10)
     ax.grid(True, alpha=0.3)
     if n <= 8:  # one legend entry per level
         handles, labels = ax.get_legend_handles_labels()
@@ -306,7 +320,7 @@ def sliding_grid(resp: RackResponse) -> tuple[np.ndarray, np.ndarray, int]:
     """(n_level, n_bay·n_slot) grids of peak sliding [m] and of pallet id (0 = empty cell),
     rows = levels bottom to top, columns = (bay, slot) left to right; and n_slot."""
     n_level = resp.beam_displacement.shape[1]
-    bay, slot = resp._bay(), resp.pallet_slot()
+    bay, slot = resp._bay(), resp._slot()
     n_bay = int(bay.max()) + 1 if resp.n_pallets else 1
     n_slot = int(slot.max()) + 1 if resp.n_pallets else 1
     val = np.full((n_level, n_bay * n_slot), np.nan)
@@ -319,26 +333,45 @@ def sliding_grid(resp: RackResponse) -> tuple[np.ndarray, np.ndarray, int]:
     return val, ids, n_slot
 
 
+#: share of the magma_r colour map used by the heat map: its last quarter is near black, which
+#: hid the pallet numbers and made a rack whose pallets all slid alike one black block
+HEATMAP_CMAP_TOP = 0.75
+#: peaks within this fraction of the largest count as "all alike" (said in the title)
+HEATMAP_UNIFORM_RTOL = 0.01
+
+
 def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 80) -> Any:
     """Peak sliding of every pallet on a level × (bay, slot) grid, with a colour bar [mm].
 
-    Cells are labelled with the pallet id when there are at most ``annotate`` pallets; a
-    pallet whose sliding reached its free distance is outlined in red. Returns the Axes.
+    Cells are labelled with the pallet id when there are at most ``annotate`` pallets, in
+    black or white after the cell's lightness so that they stay legible; a pallet whose
+    sliding reached its free distance is outlined in red. The colour map stops short of black
+    (:data:`HEATMAP_CMAP_TOP`), and when every pallet slid alike the title says so (a uniform
+    map is then the truth, not a failure). Returns the Axes.
     """
+    import matplotlib
+    from matplotlib.colors import ListedColormap, Normalize
+
     ax = _axes(ax)
     val, ids, n_slot = sliding_grid(resp)
     n_level, n_col = val.shape
     masked = np.ma.masked_invalid(val * 1e3)
-    im = ax.imshow(masked, origin="lower", aspect="auto", cmap="magma_r",
-                   vmin=0.0, vmax=max(float(masked.max()) if masked.count() else 0.0, 1e-3))
+    cmap = ListedColormap(matplotlib.colormaps["magma_r"](
+        np.linspace(0.0, HEATMAP_CMAP_TOP, 256)))
+    vmax = max(float(masked.max()) if masked.count() else 0.0, 1e-3)
+    norm = Normalize(vmin=0.0, vmax=vmax)
+    im = ax.imshow(masked, origin="lower", aspect="auto", cmap=cmap, norm=norm)
     ax.figure.colorbar(im, ax=ax, label="peak sliding [mm]")
-    risk = set(resp.pallets_at_risk())
+    risk = set(resp.pallets_at_risk()) | {f.pallet + 1 for f in resp.falls}
     for (r, c), pid in np.ndenumerate(ids):
-        if pid and pid - 1 in risk:
-            ax.add_patch(__import__("matplotlib").patches.Rectangle(
+        if pid and pid in risk:
+            ax.add_patch(matplotlib.patches.Rectangle(
                 (c - 0.5, r - 0.5), 1, 1, fill=False, ec="red", lw=1.5))
         if pid and resp.n_pallets <= annotate:
-            ax.text(c, r, str(pid), ha="center", va="center", fontsize=6, color="0.5")
+            red, green, blue, _ = cmap(norm(float(masked[r, c])))
+            light = 0.299 * red + 0.587 * green + 0.114 * blue
+            ax.text(c, r, str(pid), ha="center", va="center", fontsize=6,
+                    color="black" if light > 0.5 else "white")
     n_bay = n_col // n_slot
     for b in range(1, n_bay):
         ax.axvline(b * n_slot - 0.5, color="k", lw=0.6)
@@ -350,21 +383,42 @@ def plot_sliding_heatmap(resp: RackResponse, ax: Any = None, *, annotate: int = 
                        fontsize=7)
     ax.set_xlabel(f"bay (each split in {n_slot} slot{'s' if n_slot > 1 else ''}, left to right)")
     ax.set_ylabel("beam level")
-    ax.set_title("Peak sliding of each pallet (numbers: pallet id; red: reached its free "
-                 "distance)", fontsize=10)
+    title = ("Peak sliding of each pallet (numbers: pallet id; red: reached its free distance"
+             + (" or fell" if resp.n_dir > 1 else "") + ")")
+    if masked.count():
+        lo, hi = float(masked.min()), float(masked.max())
+        if hi - lo <= HEATMAP_UNIFORM_RTOL * max(hi, 1e-12):
+            title += (f"\nevery pallet slid alike: {hi:.3g} mm" if hi > 1e-9 else
+                      "\nno pallet slid")
+    ax.set_title(title, fontsize=10)
     return ax
 
 
 def existing_figures(out_dir: str | Path) -> list[Path]:
-    """The files of :data:`RACK_FIGURES` (and ``hinge_loops.png``) already in ``out_dir``."""
-    return [Path(out_dir) / f for f in (*RACK_FIGURES, *HINGE_FIGURES)
+    """The seisrack figures (:data:`RACK_FIGURES`, ``sliding_paths.png``,
+    ``hinge_loops.png``) already in ``out_dir``."""
+    from seisrack.report.sliding_paths import SLIDING_PATHS_FIGURE
+
+    return [Path(out_dir) / f for f in (*RACK_FIGURES, SLIDING_PATHS_FIGURE, *HINGE_FIGURES)
             if (Path(out_dir) / f).exists()]
 
 
-def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, suptitle: str | None = None,
-                      force: bool = False) -> list[Path]:
-    """Write the figures of the user's rack (:data:`RACK_FIGURES`, all levels; with nonlinear
-    connections also ``hinge_loops.png``) into ``out_dir``.
+def _direction_panels(resp: RackResponse, height: float) -> list[Any]:
+    """One Axes per horizontal direction, stacked in one figure."""
+    axes = [_axes(None)]
+    fig = axes[0].figure
+    if resp.n_dir > 1:
+        fig.clear()
+        axes = list(fig.subplots(resp.n_dir, 1, sharex=True))
+    fig.set_size_inches(7.5, height * resp.n_dir)
+    return axes
+
+
+def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, model: Any = None,
+                      suptitle: str | None = None, force: bool = False) -> list[Path]:
+    """Write the figures of the user's rack into ``out_dir``: :data:`RACK_FIGURES` (all levels,
+    one panel per horizontal direction), with two directions the plan view
+    ``sliding_paths.png`` (needs ``model``), with nonlinear connections ``hinge_loops.png``.
 
     An existing figure is never overwritten unless ``force``: raises ``InputError`` naming
     ``--force`` before anything is written.
@@ -386,30 +440,51 @@ def save_rack_figures(resp: RackResponse, out_dir: str | Path, *, suptitle: str 
         save(ax, str(out / name))
         paths.append(out / name)
 
-    ax = _axes(None)
-    ax.figure.set_size_inches(7.5, height)
-    finish(plot_levels(resp, "beam_displacement", ax), RACK_FIGURES[0])
-    ax = _axes(None)
-    ax.figure.set_size_inches(7.5, height)
-    if resp.beam_acceleration_filtered is not None:
-        plot_levels(resp, "beam_acceleration_filtered", ax)
-        raw = float(np.max(np.abs(resp.beam_acceleration), initial=0.0))
-        ax.set_title(ax.get_title() + f"\nraw (unfiltered) peak of the kept samples: "
-                     f"{raw:.2f} m/s²", fontsize=10)
-    else:
-        plot_levels(resp, "beam_acceleration", ax)
-    finish(ax, RACK_FIGURES[1])
-    ax = _axes(None)
-    ax.figure.set_size_inches(7.5, height)
-    finish(plot_levels(resp, "contact_force", ax), RACK_FIGURES[2])
-    for name, draw in ((RACK_FIGURES[3], plot_all_pallet_sliding),
-                       (RACK_FIGURES[4], plot_sliding_heatmap)):
-        ax = _axes(None)
-        ax.figure.set_size_inches(7.5, height if name != RACK_FIGURES[4]
-                                  else 2.0 + 0.35 * n_level)
+    filtered = resp.beam_acceleration_filtered is not None
+    for name, quantity in ((RACK_FIGURES[0], "beam_displacement"),
+                           (RACK_FIGURES[1], "beam_acceleration_filtered" if filtered
+                            else "beam_acceleration"),
+                           (RACK_FIGURES[2], "contact_force")):
+        axes = _direction_panels(resp, height)
+        for d, ax in enumerate(axes):
+            plot_levels(resp, quantity, ax, direction=d)
+            if quantity == "beam_acceleration_filtered":
+                raw = float(np.max(np.abs(resp.directional("beam_acceleration")[..., d]),
+                                   initial=0.0))
+                ax.set_title(ax.get_title() + f"\nraw (unfiltered) peak of the kept samples: "
+                             f"{raw:.2f} m/s²", fontsize=10)
+        finish(axes[-1], name)
+    axes = _direction_panels(resp, height)
+    for d, ax in enumerate(axes):
         if resp.n_pallets:
-            draw(resp, ax)
+            plot_all_pallet_sliding(resp, ax, direction=d)
         else:
             ax.set_title("no pallets")
-        finish(ax, name)
+    finish(axes[-1], RACK_FIGURES[3])
+    ax = _axes(None)
+    ax.figure.set_size_inches(7.5, 2.0 + 0.35 * n_level)
+    if resp.n_pallets:
+        plot_sliding_heatmap(resp, ax)
+    else:
+        ax.set_title("no pallets")
+    finish(ax, RACK_FIGURES[4])
+    if resp.n_dir > 1 and model is not None:
+        paths.append(_save_plan_view(resp, model, out, suptitle))
     return paths + save_hinge_figures(resp, out, suptitle=suptitle)
+
+
+def _save_plan_view(resp: RackResponse, model: Any, out: Path, suptitle: str | None) -> Path:
+    from seisrack.report.sliding_paths import SLIDING_PATHS_FIGURE, plot_sliding_paths
+
+    fig = plot_sliding_paths(resp, model)
+    if suptitle:
+        title = fig.get_suptitle()
+        fig.suptitle(f"{suptitle}\n{title}" if title else suptitle, fontsize=9)
+        fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.65 / fig.get_figheight()))
+    from seisrack.atomic import save_figure
+
+    save_figure(fig, out / SLIDING_PATHS_FIGURE, dpi=120)
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return out / SLIDING_PATHS_FIGURE

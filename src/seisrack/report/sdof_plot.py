@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from seisrack.atomic import save_figure
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
@@ -72,6 +74,6 @@ def save_sdof_figure(sol: SdofSolution, path: str | Path) -> Path:
     )
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path, dpi=120)
     plt.close(fig)
     return path

@@ -1,29 +1,25 @@
-"""Figures of a 3D rack time history: where the pallets slide in plan, and when.
+"""Where the pallets of a rack with two horizontal directions (a 3D rack) slide, in plan:
+:func:`plot_sliding_paths`, a plan view of each loaded beam level (x down-aisle along the rack,
+z cross-aisle: front beam at z = 0, rear beam at z = depth, and the second row's frames of a
+back-to-back rack beyond the flue) with every pallet's footprint and
+the path of its centre, magnified so that small sliding is visible; the fall limits are dashed
+on each footprint and fallen pallets are red. Written as ``sliding_paths.png`` by
+:func:`seisrack.report.rack_plot.save_rack_figures`.
 
-- :func:`plot_sliding_paths`: a plan view of each loaded beam level (x down-aisle along the
-  rack, z cross-aisle: front beam at z = 0, rear beam at z = depth) with every pallet's
-  footprint and the path of its centre, magnified so that small sliding is visible; the fall
-  limits are dashed on each footprint and fallen pallets are red.
-- :func:`plot_pallet_histories`: sliding down-aisle and cross-aisle against time of the pallets
-  that slide most, with the cross-aisle fall limits dashed.
-- :func:`save_rack3d_figures`: both as PNG files in an output folder.
-
-matplotlib is imported lazily (Agg backend unless an interactive one is already chosen, as in
-:mod:`seisrack.report.rack_plot`); nothing here calls ``show()``.
+matplotlib is imported lazily; nothing here calls ``show()``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from seisrack.analysis.rack3d import RackResponse3D
+from seisrack.analysis.response import RackResponse
 
-#: file names written by :func:`save_rack3d_figures`
-RACK3D_FIGURES = ("sliding_paths.png", "pallet_sliding.png")
+#: the plan-view figure's file name
+SLIDING_PATHS_FIGURE = "sliding_paths.png"
 #: pallet width along the beams [m] when none is given (the spec's width is not on the model)
 DEFAULT_WIDTH = 0.8
 #: the largest sliding path is drawn about this long [m] by the default magnification
@@ -48,18 +44,18 @@ def default_magnify(peak: float) -> float:
     return max(1.0, float(f"{_SHOWN_PEAK / peak:.1g}"))
 
 
-def _fall_map(resp: RackResponse3D) -> dict[int, Any]:
+def _fall_map(resp: RackResponse) -> dict[int, Any]:
     return {f.pallet: f for f in resp.falls}
 
 
 def plot_sliding_paths(
-    resp: RackResponse3D, model: Any, *, magnify: float | None = None,
+    resp: RackResponse, model: Any, *, magnify: float | None = None,
     widths: Sequence[float] | np.ndarray | None = None,
 ) -> Any:
     """Plan view of the sliding path of every pallet, one panel per loaded level (top level on
     top). Returns the Figure.
 
-    model: the :class:`~seisrack.model.frame_model3d.FrameModel3D` that was run.
+    model: the compiled 3D rack that was run.
     magnify: factor on the sliding (and on the fall limits, so that the two compare);
         default :func:`default_magnify` of the largest peak sliding magnitude.
     widths: (m,) pallet widths along the beams [m] (default 0.8 m each).
@@ -70,25 +66,31 @@ def plot_sliding_paths(
     from matplotlib.patches import Rectangle
 
     m = resp.n_pallets
-    peak = float(np.max(resp.peak_sliding[:, 2])) if m else 0.0
+    peak = float(np.max(resp.pallet_peak_sliding())) if m else 0.0
     mag = default_magnify(peak) if magnify is None else float(magnify)
     w = np.full(m, DEFAULT_WIDTH) if widths is None else np.asarray(widths, dtype=float)
     depth = float(model.depth)
-    zc = depth / 2
+    # each pallet centred between the two beams it rests on (its row's, on a back-to-back
+    # rack); a frame line at each upright side
+    support_z = np.asarray(model.nodes)[np.asarray(model.pallet_node), 2]
+    zc_all = support_z.mean(axis=1) if support_z.size else np.zeros(0)
+    frames = (np.asarray(model.frame_z) if getattr(model, "frame_z", None) is not None
+              else np.array([0.0, depth]))
     px = np.asarray(model.nodes)[np.asarray(model.pallet_node)[:, 0], 0]
     pdep = np.where(np.isfinite(model.pallet_depth), model.pallet_depth, depth)
     up_x = np.asarray(model.upright_x)
-    levels = sorted({int(v) for v in resp.pallet_level}, reverse=True) or [1]
+    levels = sorted({int(v) + 1 for v in resp.pallet_level}, reverse=True) or [1]
     falls = _fall_map(resp)
     fig, axes = plt.subplots(len(levels), 1, squeeze=False,
                              figsize=(max(6.0, 1.6 * (up_x[-1] - up_x[0]) + 2.0),
                                       1.0 + 2.6 * len(levels)))
     for ax, lv in zip(axes[:, 0], levels, strict=True):
-        for z in (0.0, depth):
+        for z in frames:
             ax.plot([up_x[0], up_x[-1]], [z, z], color="0.3", lw=2.0, zorder=1)
-        ax.plot(np.repeat(up_x, 2), np.tile([0.0, depth], up_x.size), "s", color="0.2",
+        ax.plot(np.repeat(up_x, frames.size), np.tile(frames, up_x.size), "s", color="0.2",
                 ms=5, zorder=2, label="uprights")
-        for p in np.flatnonzero(resp.pallet_level == lv):
+        for p in np.flatnonzero(resp.pallet_level == lv - 1):
+            zc = zc_all[p]
             fall = falls.get(int(p))
             colour = "red" if fall is not None else "C0"
             x0, hw, hd = px[p], w[p] / 2, pdep[p] / 2
@@ -98,7 +100,7 @@ def plot_sliding_paths(
                 if np.isfinite(lim):
                     ax.plot([x0 - hw, x0 + hw], [zc + sign * mag * lim] * 2, ls="--",
                             color=colour, lw=0.8, zorder=3)
-            u = resp.sliding[:, p, :]
+            u = resp.pallet_sliding[:, p, :]
             ax.plot(x0 + mag * u[:, 0], zc + mag * u[:, 1], color=colour, lw=0.7, zorder=4)
             ax.plot([x0], [zc], "+", color="k", ms=6, zorder=5)
             ax.text(x0 - hw + 0.02, zc + hd - 0.02, str(p + 1), fontsize=7, va="top",
@@ -118,83 +120,9 @@ def plot_sliding_paths(
                      + (" (true scale)" if mag == 1 else ""), fontsize=9)
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel("down-aisle x [m] (front beam at z = 0, rear beam at z = depth)")
-    fig.suptitle(f"Pallet sliding in plan: {resp.motion_name}, angle {resp.angle_deg:g}°"
+    fig.suptitle(f"Pallet sliding in plan: {resp.record_name}, angle {resp.angle_deg:g}°"
                  "\ndashed: fall limits (magnified like the paths); red: the pallet falls",
                  fontsize=10)
+    # leave room for the two-line title above the panels' own titles
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.5 / fig.get_figheight()))
     return fig
-
-
-def _largest(resp: RackResponse3D, n: int = 4) -> list[int]:
-    order = np.argsort(-resp.peak_sliding[:, 2], kind="stable")
-    return [int(p) for p in order[:n]]
-
-
-def plot_pallet_histories(resp: RackResponse3D, pallets: Sequence[int] | None = None) -> Any:
-    """Sliding down-aisle (top) and cross-aisle (bottom) against time [mm] of ``pallets``
-    (0-based; default the 4 with the largest peak magnitude), with each pallet's cross-aisle
-    fall limits (−front, +rear) as dashed lines and its fall marked. Returns the Figure."""
-    plt = _pyplot()
-    sel = _largest(resp) if pallets is None else [int(p) for p in pallets]
-    falls = _fall_map(resp)
-    fig, (ax_x, ax_z) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 5.6))
-    for i, p in enumerate(sel):
-        c = f"C{i % 10}"
-        lab = f"pallet {p + 1} (level {int(resp.pallet_level[p])}, bay {int(resp.pallet_bay[p])})"
-        ax_x.plot(resp.t, resp.sliding[:, p, 0] * 1e3, lw=0.7, color=c, label=lab)
-        ax_z.plot(resp.t, resp.sliding[:, p, 1] * 1e3, lw=0.7, color=c, label=lab)
-        for lim, sign in ((resp.fall_front[p], -1.0), (resp.fall_rear[p], 1.0)):
-            if np.isfinite(lim):
-                ax_z.axhline(sign * lim * 1e3, color=c, ls="--", lw=0.7)
-        fall = falls.get(p)
-        if fall is not None:
-            zf = np.interp(fall.time_s, resp.t, resp.sliding[:, p, 1]) * 1e3
-            ax_z.plot([fall.time_s], [zf], "x", color=c, ms=8, mew=2)
-    ax_x.set_ylabel("down-aisle sliding [mm]")
-    ax_z.set_ylabel("cross-aisle sliding [mm]")
-    ax_z.set_xlabel("time [s]")
-    for ax in (ax_x, ax_z):
-        ax.grid(True, alpha=0.3)
-        ax.axhline(0.0, color="k", lw=0.4)
-    if sel:
-        ax_x.legend(fontsize=7, loc="upper right")
-    fig.suptitle(f"Sliding of the pallets relative to their beams\n{resp.motion_name}, "
-                 f"angle {resp.angle_deg:g}°", fontsize=10)
-    ax_x.set_title(f"down-aisle (x), the {len(sel)} pallet{'s' * (len(sel) != 1)} "
-                   "that slide most" if pallets is None else "down-aisle (x)", fontsize=9)
-    ax_z.set_title("cross-aisle (z); dashed: fall limits (front −, rear +); x: the pallet "
-                   "falls", fontsize=9)
-    return fig
-
-
-def existing_figures_3d(out: str | Path) -> list[Path]:
-    """The files of :data:`RACK3D_FIGURES` already in ``out``."""
-    return [Path(out) / f for f in RACK3D_FIGURES if (Path(out) / f).exists()]
-
-
-def save_rack3d_figures(resp: RackResponse3D, model: Any, out: str | Path, *,
-                        suptitle: str = "", force: bool = False) -> list[Path]:
-    """Write :data:`RACK3D_FIGURES` into the folder ``out`` (created if missing).
-
-    An existing figure is never overwritten unless ``force``: raises ``InputError`` before
-    anything is written.
-    """
-    out = Path(out)
-    if existing_figures_3d(out) and not force:
-        from seisrack.errors import InputError
-
-        raise InputError("--out", str(out),
-                         "a folder without seisrack figures, or --force to overwrite them")
-    out.mkdir(parents=True, exist_ok=True)
-    plt = _pyplot()
-    paths = []
-    for name, draw in ((RACK3D_FIGURES[0], lambda: plot_sliding_paths(resp, model)),
-                       (RACK3D_FIGURES[1], lambda: plot_pallet_histories(resp))):
-        fig = draw()
-        if suptitle:
-            title = fig.get_suptitle()
-            fig.suptitle(f"{suptitle}\n{title}" if title else suptitle, fontsize=9)
-        fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-        paths.append(out / name)
-    return paths

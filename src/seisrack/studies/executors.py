@@ -52,8 +52,20 @@ _CTX: Any = None  # the StudyPlan (without its runs) of the current process
 _CTX_ID: str | None = None
 _MODELS: dict = {}
 _RECORDS: dict = {}
+_RIGID: dict = {}  # rigid-pallet companion peaks by (rack, occupancy, record, scale)
 _LIMITER: Any = None
 _CACHE_MAX = 128
+#: [s] how long a --scheduler address may take to answer as a Dask scheduler
+SCHEDULER_TIMEOUT_S = 15
+
+
+def _worker_init(ctx: Any, parent_pid: int) -> None:
+    """Initializer of a pool worker: follow the driver if it dies (no orphans, see
+    :mod:`seisrack.studies.lifeline`), then take the study's context."""
+    from seisrack.studies.lifeline import die_with_parent
+
+    die_with_parent(parent_pid)
+    _set_context(ctx)
 
 
 def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
@@ -63,6 +75,7 @@ def _set_context(ctx: Any, ctx_id: str | None = None) -> None:
     _CTX, _CTX_ID = ctx, ctx_id
     _MODELS.clear()
     _RECORDS.clear()
+    _RIGID.clear()
     if _LIMITER is None:
         from threadpoolctl import threadpool_limits
 
@@ -124,11 +137,12 @@ def _hook(run) -> None:  # noqa: ANN001
 
 
 def _model(run):  # noqa: ANN001, ANN202
-    """(model with the run's friction, rack spec as loaded, basis) for ``run``.
+    """(model with the run's friction, rack spec as loaded, prepared run) for ``run``.
 
-    Friction enters the compiled model only through its pallet friction arrays, and the
-    engine's basis depends on the structure and the pallet masses only: both are built once
-    per (rack, occupancy) and process; a run replaces the friction arrays (exactly what
+    Friction enters the compiled model only through its pallet friction arrays, and what a
+    run prepares (:func:`seisrack.analysis.prepare_run`: the basis and the operators) depends
+    on the structure and the pallet masses only: both are built once per (rack, occupancy) and
+    process; a run replaces the friction arrays (exactly what
     ``compile_rack(with_friction(rack, mu_s, mu_d))`` gives).
     """
     from dataclasses import replace
@@ -140,52 +154,39 @@ def _model(run):  # noqa: ANN001, ANN202
         from seisrack.studies.expand import apply_pattern
 
         rack = apply_pattern(_CTX.racks[run.rack_hash], _CTX.patterns[key])
+        from seisrack.analysis import prepare_run
+
         model = compile_rack(rack)
-        basis = _basis(model)
-        hit = (model, rack, basis, _operators(model, basis))
+        hit = (model, rack, prepare_run(model))
         if len(_MODELS) >= _CACHE_MAX:
             _MODELS.clear()
         _MODELS[key] = hit
-    model, rack, basis, ops = hit
+    model, rack, prepared = hit
     n = model.pallet_mass.shape[0]
     model = replace(model, pallet_mu_static=np.full(n, float(run.mu_static)),
                     pallet_mu_dynamic=np.full(n, float(run.mu_dynamic)))
-    return model, rack, basis, ops
-
-
-def _operators(model, basis):  # noqa: ANN001, ANN202
-    """The rack operators projected on ``basis`` (friction does not enter them), or None."""
-    if isinstance(basis, str):
-        return None
-    from seisrack.analysis.peaks import rack_operators
-
-    return rack_operators(model, basis.phi)
-
-
-def _basis(model):  # noqa: ANN001, ANN202
-    """The basis ``run_rack(basis="auto")`` would build (or "auto": built by every run)."""
-    try:
-        from seisrack.analysis.hinges import rack_hinges
-        from seisrack.analysis.rack import rack_basis
-        from seisrack.dynamics.sliders import Sliders
-
-        sliders = Sliders(model.pallet_dof, model.pallet_mass, model.pallet_mu_static,
-                          model.pallet_mu_dynamic)
-        # nonlinear connections: the Ritz basis needs their hinge vectors, as in run_rack
-        return rack_basis(model, sliders, "auto", None, rack_hinges(model))
-    except (ImportError, TypeError):  # pragma: no cover - an engine without this helper
-        return "auto"
+    return model, rack, prepared
 
 
 def _scaled(run):  # noqa: ANN001, ANN202
-    key = (run.record_hash, run.scale_factor)
+    """The run's ground motion: its record (every component) scaled by the run's factor, a
+    pair or a turned motion as a GroundMotion (3D racks)."""
+    key = (run.record_hash, run.scale_factor, getattr(run, "angle_deg", 0.0))
     rec = _RECORDS.get(key)
     if rec is None:
         from seisrack.motion import Record
+        from seisrack.motion.components import combine
 
-        base = _CTX.records[run.record_hash]
-        rec = Record(base.accel * run.scale_factor, base.dt, name=base.name,
-                     provenance=f"{base.provenance}, scaled by {run.scale_factor:.6g}")
+        comps = tuple(Record(c.accel * run.scale_factor, c.dt, name=c.name,
+                             provenance=f"{c.provenance}, scaled by {run.scale_factor:.6g}")
+                      for c in _CTX.records[run.record_hash])
+        angle = getattr(run, "angle_deg", 0.0)
+        rec = comps[0] if len(comps) == 1 and angle == 0.0 else combine(
+            comps[0], comps[1] if len(comps) > 1 else None, None, angle)
+        if not isinstance(rec, Record) and _CTX.racks[run.rack_hash].ndm == 2:
+            # a warehouse's 2D row: the motion along its down-aisle axis
+            rec = Record(rec.x, rec.dt, name=comps[0].name,
+                         provenance=f"{comps[0].provenance}, along a row at {-angle:g} deg")
         if len(_RECORDS) >= _CACHE_MAX:
             _RECORDS.clear()
         _RECORDS[key] = rec
@@ -196,7 +197,8 @@ def _inputs(run) -> dict[str, Any]:  # noqa: ANN001
     return {"run_id": run.run_id, "rack": run.rack, "record": run.record,
             "im_measure": run.im_measure, "im_target": run.im_target,
             "scale_factor": run.scale_factor, "stripe": run.stripe, "mu_static": run.mu_static,
-            "mu_dynamic": run.mu_dynamic, "occupancy": run.occupancy, "seed": run.seed}
+            "mu_dynamic": run.mu_dynamic, "occupancy": run.occupancy, "seed": run.seed,
+            "angle_deg": float(getattr(run, "angle_deg", 0.0))}
 
 
 def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # noqa: ANN001
@@ -204,7 +206,9 @@ def failed_row(run, reason: str, wall: float = math.nan) -> dict[str, Any]:  # n
     return {**_inputs(run), "status": "failed", "error": reason, "peak_sliding_max_m": nan,
             "pallet_peak_sliding_m": [], "n_pallets": 0, "any_fall": False, "n_fall": 0,
             "base_shear_N": nan, "beam_displacement_max_m": nan, "drift_ratio_max": nan,
-            "upright_moment_connection_Nm": nan, "wall_time_s": wall}
+            "upright_moment_connection_Nm": nan, "wall_time_s": wall,
+            **dict.fromkeys(REDUCTION_COLUMNS, nan), "any_aisle_fall": False,
+            "n_aisle_fall": 0, **dict.fromkeys(DIRECTION_COLUMNS, nan)}
 
 
 def skipped_row(run, stop_im: float, rule) -> dict[str, Any]:  # noqa: ANN001
@@ -220,14 +224,14 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
     t0 = time.perf_counter()
     try:
         _hook(run)
-        model, rack, basis, ops = _model(run)
+        model, rack, prepared = _model(run)
         res = run_rack(model, _scaled(run), dt=_CTX.dt, save_every=None, track_energy=False,
-                       throw=False, basis=basis, operators=ops)
+                       throw=False, prepared=prepared)
         if res.status != "ok":
             return failed_row(run, f"solver status: {res.status}", time.perf_counter() - t0)
         fp = res.full_peaks
         sliding = res.pallet_peak_sliding()
-        disp = np.asarray(fp["beam_displacement"], dtype=float)
+        disp = np.asarray(fp["beam_displacement"], dtype=float)[:, 0]
         # drift: an envelope from the per-level peaks (exact for one level; above, peaks of
         # adjacent levels need not be simultaneous)
         heights = np.asarray(rack.geometry.levels, dtype=float)
@@ -237,14 +241,73 @@ def run_one(run) -> dict[str, Any]:  # noqa: ANN001
                 "peak_sliding_max_m": float(sliding.max()) if sliding.size else 0.0,
                 "pallet_peak_sliding_m": [float(s) for s in sliding],
                 "n_pallets": int(res.n_pallets), "any_fall": bool(at_risk),
-                "n_fall": len(at_risk), "base_shear_N": float(fp["base_shear"]),
+                "n_fall": len(at_risk), "base_shear_N": float(np.max(fp["base_shear"])),
                 "beam_displacement_max_m": float(disp.max()),
                 "drift_ratio_max": float(drift.max()),
-                "upright_moment_connection_Nm": float(fp["upright_moment_connection"]),
+                "upright_moment_connection_Nm": float(np.max(fp["upright_moment_connection"])),
+                **_reduction_columns(run, res, model, prepared),
+                **_direction_columns(res),
                 "wall_time_s": time.perf_counter() - t0}
     except Exception as exc:  # noqa: BLE001 - a failed run is a row, never a stopped study
         kind = "" if isinstance(exc, SeisrackError) else f"{type(exc).__name__}: "
         return failed_row(run, f"{kind}{exc}", time.perf_counter() - t0)
+
+
+#: per-direction peak sliding columns (null cross-aisle on a 2D rack: not applicable)
+DIRECTION_COLUMNS = ("peak_sliding_down_aisle_max_m", "peak_sliding_cross_aisle_max_m")
+
+
+def _direction_columns(res) -> dict[str, Any]:  # noqa: ANN001
+    """Falls into the aisles (3D racks; none on a 2D rack) and the peak sliding along each
+    direction."""
+    by_dir = res.pallet_peak_sliding_by_direction()
+    peak = by_dir.max(axis=0) if by_dir.size else np.zeros(by_dir.shape[1])
+    aisle = sum(1 for f in res.falls if f.into_aisle)  # a back-to-back rack's flue excluded
+    return {"any_aisle_fall": aisle > 0, "n_aisle_fall": aisle,
+            "peak_sliding_down_aisle_max_m": float(peak[0]),
+            "peak_sliding_cross_aisle_max_m": float(peak[1]) if peak.size > 1 else None}
+
+
+#: columns of the sliding reduction (issue 24 item 2): this run's seismic connector and upright
+#: moments, and the peaks of the same rack and scaled record with the pallets held rigidly
+#: (rigid_alpha: its peak absolute level acceleration over g, the paper's alpha)
+REDUCTION_COLUMNS = ("connector_moment_Nm", "upright_moment_Nm", "rigid_base_shear_N",
+                     "rigid_connector_moment_Nm", "rigid_upright_moment_Nm",
+                     "rigid_alpha")
+
+
+def _reduction_columns(run, res, model, prepared) -> dict[str, float]:  # noqa: ANN001
+    """This run's peaks for the sliding reduction and its rigid companion's (the rigid run
+    depends on the rack, occupancy, record, scale and incidence angle only: one per process
+    and key)."""
+    from seisrack.design.sliding_reduction import response_peaks, rigid_model
+
+    mine = response_peaks(res)
+    key = (run.rack_hash, run.occupancy, run.record_hash, run.scale_factor,
+           getattr(run, "angle_deg", 0.0))
+    rigid = _RIGID.get(key)
+    if rigid is None:
+        rigid = dict.fromkeys(REDUCTION_COLUMNS[2:], math.nan)
+        if model.n_pallets:
+            from seisrack.analysis import run_rack
+
+            try:
+                r = run_rack(rigid_model(model), _scaled(run), dt=_CTX.dt, save_every=None,
+                             track_energy=False, throw=False, prepared=prepared)
+            except Exception as exc:  # noqa: BLE001 - the companion never fails the run
+                log.warning("rigid companion of run %s failed: %s", run.run_id, exc)
+                r = None
+            if r is not None and r.status == "ok":
+                p = response_peaks(r)
+                rigid = {"rigid_base_shear_N": p["base_shear_N"],
+                         "rigid_connector_moment_Nm": p["connector_moment_Nm"],
+                         "rigid_upright_moment_Nm": p["upright_moment_Nm"],
+                         "rigid_alpha": p["level_acceleration_m_s2"] / float(model.g)}
+        if len(_RIGID) >= _CACHE_MAX:
+            _RIGID.clear()
+        _RIGID[key] = rigid
+    return {"connector_moment_Nm": mine["connector_moment_Nm"],
+            "upright_moment_Nm": mine["upright_moment_Nm"], **rigid}
 
 
 def _context_of(plan) -> Any:  # noqa: ANN001
@@ -268,8 +331,8 @@ class LocalExecutor:
 
         pending = deque((b, 0) for b in batches)
         while pending:
-            pool = ProcessPoolExecutor(self.workers, initializer=_set_context,
-                                       initargs=(self.ctx,))
+            pool = ProcessPoolExecutor(self.workers, initializer=_worker_init,
+                                       initargs=(self.ctx, os.getpid()))
             inflight: dict = {}
             broken: list = []
             try:
@@ -331,15 +394,24 @@ class DaskExecutor:
         cluster = None
         if self.scheduler:
             try:
-                client = Client(self.scheduler, timeout="20s")
-            except (OSError, TimeoutError, ValueError) as exc:
+                client = Client(self.scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s")
+            except Exception as exc:  # noqa: BLE001 - whatever answered is not a scheduler
+                # (an HTTP server's reply read as a Dask frame length asks for exabytes: a
+                # MemoryError; nothing at all: a timeout; a bad address: ValueError)
                 from seisrack.errors import InputError
 
-                raise InputError("scheduler", self.scheduler, "the address of a running Dask "
-                                 "scheduler, e.g. tcp://10.0.0.1:8786", hint=str(exc)) from None
+                why = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
+                raise InputError("--scheduler", self.scheduler, "the address of a running Dask "
+                                 "scheduler, e.g. tcp://SCHEDULER-HOST:8786",
+                                 hint=f"What is there is not a Dask scheduler, or it did not "
+                                      f"answer within {SCHEDULER_TIMEOUT_S} s "
+                                      f"({type(exc).__name__}"
+                                      + (f": {why}" if why else "") + ")") from None
         else:
+            # on the loopback interface: a local cluster is nobody else's business
             cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.WARNING)
+                                   host="127.0.0.1", dashboard_address=None,
+                                   silence_logs=logging.WARNING)
             client = Client(cluster)
         try:
             ctx = client.scatter(self.ctx, broadcast=True)

@@ -13,6 +13,12 @@ same (rack, record, occupancy, sample index) sees the same friction at every int
 (common random numbers: an IDA curve follows one realisation, and stripes differ only by
 intensity).
 
+3D racks. A record may be a pair of horizontal components (``records.pairs``, generated
+``components = 2``), applied down-aisle and cross-aisle and turned by the incidence angle
+(``[angle]``, a list or uniform samples drawn like the friction samples). A pair's intensity is
+the geometric mean of its two components' (PGA or Sa(T1)), and both are scaled by the same
+factor. Runs that turn the motion or use a pair need 3D racks.
+
 IDA curves. With a stop rule (``intensity.ida.stop_when``) the run table is still the full
 grid, with the same ids: the runs of one curve (:func:`curve_key`) are run in increasing order
 in one task, and those above the level where the rule holds are stored with status "skipped".
@@ -54,6 +60,8 @@ class Run:
     occupancy: float
     seed: int
     period_s: float  # T1 of the rack as loaded (NaN unless measure = "sa")
+    angle_deg: float = 0.0  # incidence angle of the horizontal components [deg]
+    components: int = 1  # horizontal components of the record: 1, or 2 (a pair)
 
 
 @dataclass(frozen=True)
@@ -61,7 +69,8 @@ class StudyPlan:
     """The expanded study: runs, and what a worker needs to run them.
 
     racks: rack hash -> RackSpec (all pallets); patterns: (rack hash, occupancy) -> kept pallet
-    indices; records: record hash -> unscaled :class:`Record`.
+    indices; records: record hash -> the unscaled :class:`Record` of each horizontal component
+    (a tuple of one, or two for a pair).
     """
 
     runs: tuple[Run, ...]
@@ -88,11 +97,12 @@ def plan(spec: StudySpec) -> StudyPlan:
         racks[h] = load_rack(path)
         rack_keys.append((given, h))
     records = _load_records(spec)
+    _check_dimensions(spec, racks, records)
     patterns = {}
     runs: list[Run] = []
     intensity = spec.intensity
     levels = intensity.levels
-    for given, rh in rack_keys:
+    for r_index, (given, rh) in enumerate(rack_keys):
         rack = racks[rh]
         for occ in spec.occupancy:
             kept = _pattern(len(rack.pallets), occ, spec.seed, rh)
@@ -100,21 +110,26 @@ def plan(spec: StudySpec) -> StudyPlan:
             period = math.nan
             if intensity.measure == "sa":
                 period = _first_period(rack, kept, given)
-            for name, rec_h, rec in records:
-                im0 = _intensity_of(rec, intensity.measure, period, intensity.damping)
-                _check_reachable(name, rec, im0, levels, intensity, spec.dt, period)
-                for mu_s in _friction_samples(spec, rh, rec_h, occ):
-                    mu_d = mu_s * spec.friction.dynamic_ratio
-                    for k, target in enumerate(levels):
-                        rid = run_id(rh, name, rec_h, intensity.measure, target, mu_s, mu_d,
-                                     occ, spec.seed, spec.dt)
-                        runs.append(Run(
-                            run_id=rid, rack=given, rack_hash=rh, record=name,
-                            record_hash=rec_h, im_measure=intensity.measure,
-                            im_target=float(target), scale_factor=float(target / im0),
-                            stripe=-1 if intensity.is_ida else k, mu_static=float(mu_s),
-                            mu_dynamic=float(mu_d), occupancy=float(occ), seed=spec.seed,
-                            period_s=float(period)))
+            for name, rec_h, comps in records:
+                im0 = float(np.exp(np.mean([np.log(_intensity_of(
+                    c, intensity.measure, period, intensity.damping)) for c in comps])))
+                _check_reachable(name, comps[0], im0, levels, intensity, spec.dt, period)
+                angles = (spec.rack_angles[r_index] if spec.rack_angles
+                          else _angle_samples(spec, rh, rec_h, occ))
+                for angle in angles:
+                    for mu_s in _friction_samples(spec, rh, rec_h, occ):
+                        mu_d = mu_s * spec.friction.dynamic_ratio
+                        for k, target in enumerate(levels):
+                            rid = run_id(rh, name, rec_h, intensity.measure, target, mu_s,
+                                         mu_d, occ, spec.seed, spec.dt, angle, len(comps))
+                            runs.append(Run(
+                                run_id=rid, rack=given, rack_hash=rh, record=name,
+                                record_hash=rec_h, im_measure=intensity.measure,
+                                im_target=float(target), scale_factor=float(target / im0),
+                                stripe=-1 if intensity.is_ida else k, mu_static=float(mu_s),
+                                mu_dynamic=float(mu_d), occupancy=float(occ), seed=spec.seed,
+                                period_s=float(period), angle_deg=float(angle),
+                                components=len(comps)))
     dup = [i for i, c in Counter(r.run_id for r in runs).items() if c > 1]
     if dup:
         raise InputError("friction.values", spec.friction.values,
@@ -126,24 +141,32 @@ def plan(spec: StudySpec) -> StudyPlan:
 
 
 def curve_key(run: Run) -> tuple:
-    """The IDA curve of ``run``: (rack, occupancy, record, friction); levels vary along it."""
+    """The IDA curve of ``run``: (rack, occupancy, record, friction, angle); levels vary
+    along it."""
     return (run.rack_hash, run.occupancy, run.record, run.record_hash, run.mu_static,
-            run.mu_dynamic)
+            run.mu_dynamic, run.angle_deg)
 
 
 def run_id(rack_hash: str, record: str, record_hash: str, measure: str, target: float,
-           mu_s: float, mu_d: float, occupancy: float, seed: int, dt: float) -> str:
-    """16 hex digits of the SHA-256 of the defining inputs (floats by their exact repr)."""
-    key = json.dumps([rack_hash, record, record_hash, measure, repr(float(target)),
-                      repr(float(mu_s)), repr(float(mu_d)), repr(float(occupancy)), int(seed),
-                      repr(float(dt))])
-    return hashlib.sha256(key.encode()).hexdigest()[:16]
+           mu_s: float, mu_d: float, occupancy: float, seed: int, dt: float,
+           angle_deg: float = 0.0, components: int = 1) -> str:
+    """16 hex digits of the SHA-256 of the defining inputs (floats by their exact repr). The
+    angle and the number of components enter only when they differ from one component at
+    0°, so the ids of a down-aisle study are those of earlier versions (its store resumes)."""
+    parts = [rack_hash, record, record_hash, measure, repr(float(target)), repr(float(mu_s)),
+             repr(float(mu_d)), repr(float(occupancy)), int(seed), repr(float(dt))]
+    if angle_deg != 0.0 or components != 1:
+        parts += [repr(float(angle_deg)), int(components)]
+    return hashlib.sha256(json.dumps(parts).encode()).hexdigest()[:16]
 
 
-def record_hash(rec: Record) -> str:
-    """Content hash of a record: its samples and time step (not its name)."""
-    h = hashlib.sha256(np.ascontiguousarray(rec.accel, dtype="<f8").tobytes())
-    h.update(repr(float(rec.dt)).encode())
+def record_hash(rec: Record | tuple[Record, ...]) -> str:
+    """Content hash of a record (or a pair): its samples and time step (not its name)."""
+    comps = rec if isinstance(rec, tuple) else (rec,)
+    h = hashlib.sha256()
+    for c in comps:
+        h.update(np.ascontiguousarray(c.accel, dtype="<f8").tobytes())
+        h.update(repr(float(c.dt)).encode())
     return h.hexdigest()[:16]
 
 
@@ -155,11 +178,13 @@ def _seed_key(*parts: object) -> int:
     return int(hashlib.sha256(json.dumps([repr(p) for p in parts]).encode()).hexdigest()[:8], 16)
 
 
-def _load_records(spec: StudySpec) -> list[tuple[str, str, Record]]:
+def _load_records(spec: StudySpec) -> list[tuple[str, str, tuple[Record, ...]]]:
+    """(name, content hash, components) of every record of the study: one component, or a
+    pair (down-aisle, cross-aisle)."""
     from seisrack.motion import generate_ec8_record, load_builtin_record, read_record
 
     rs = spec.records
-    out: list[Record] = []
+    out: list[tuple[str, tuple[Record, ...]]] = []
     if rs.folder is not None:
         files = sorted(p for p in Path(rs.folder).iterdir()
                        if p.is_file() and p.suffix.lower() in RECORD_SUFFIXES)
@@ -167,29 +192,82 @@ def _load_records(spec: StudySpec) -> list[tuple[str, str, Record]]:
             raise InputError("records.folder", rs.folder_as_given,
                              "a folder holding record files (" + ", ".join(RECORD_SUFFIXES) + ")",
                              source=spec.source)
+        read = {}
         for f in files:
             try:
-                out.append(read_record(f, units=rs.units, dt=rs.file_dt))
+                read[f] = read_record(f, units=rs.units, dt=rs.file_dt)
             except SeisrackError as exc:
                 raise InputError("records.folder", str(f), "a readable record file",
                                  source=spec.source, hint=str(exc)) from None
-    out.extend(load_builtin_record(name) for name in rs.builtin)
+        if rs.pairs:
+            out.extend(_pairs(read, spec))
+        else:
+            out.extend((r.name, (r,)) for r in read.values())
+    out.extend((name, (load_builtin_record(name),)) for name in rs.builtin)
     for i, s in enumerate(rs.ec8):
         for k in range(s.count):
             name = f"ec8_t{s.type}{s.ground}_ag{s.ag:g}_d{s.duration:g}_s{s.seed + k}"
-            try:
-                out.append(generate_ec8_record(type=s.type, ground=s.ground, ag=s.ag,
-                                               duration=s.duration, dt=s.dt, seed=s.seed + k,
-                                               name=name))
-            except SeisrackError as exc:
-                raise InputError(f"records.ec8[{i}]", s, "parameters the EC8 generator accepts",
-                                 source=spec.source, hint=str(exc)) from None
-    names = Counter(r.name for r in out)
+            comps = []
+            for c in range(s.components):
+                # a pair's second component from its own seed, far from the first ones
+                seed = s.seed + k + 100_003 * c
+                try:
+                    comps.append(generate_ec8_record(
+                        type=s.type, ground=s.ground, ag=s.ag, duration=s.duration, dt=s.dt,
+                        seed=seed, name=name + ("", "_cross")[c]))
+                except SeisrackError as exc:
+                    raise InputError(f"records.ec8[{i}]", s, "parameters the EC8 generator "
+                                     "accepts", source=spec.source, hint=str(exc)) from None
+            out.append((name, tuple(comps)))
+    names = Counter(n for n, _ in out)
     dup = sorted(n for n, c in names.items() if c > 1)
     if dup:
         raise InputError("records", dup, "records with distinct names (file stems, bundled "
                          "names and generated suites must not repeat)", source=spec.source)
-    return [(r.name, record_hash(r), r) for r in out]
+    return [(n, record_hash(comps), comps) for n, comps in out]
+
+
+def _pairs(read: dict, spec: StudySpec) -> list[tuple[str, tuple[Record, ...]]]:
+    """Group a folder's records into pairs: names equal up to their last ``_``/``-`` token."""
+    groups: dict[str, list] = {}
+    for f, rec in read.items():
+        stem = f.stem
+        cut = max(stem.rfind("_"), stem.rfind("-"))
+        groups.setdefault(stem[:cut] if cut > 0 else stem, []).append((f, rec))
+    out = []
+    for key, members in sorted(groups.items()):
+        if len(members) != 2:
+            raise InputError("records.pairs", [m[0].name for m in members],
+                             "exactly two files per pair, whose names differ only by their "
+                             "last '_' or '-' token (e.g. RSN6_X-ELC180.AT2 and "
+                             "RSN6_X-ELC270.AT2)", source=spec.source)
+        (fa, a), (fb, b) = sorted(members, key=lambda m: m[0].name)
+        if abs(a.dt - b.dt) > 1e-9 * a.dt or a.n != b.n:
+            raise InputError("records.pairs", [fa.name, fb.name],
+                             "two components with the same time step and length",
+                             source=spec.source, hint=f"{fa.name}: {a.n} x {a.dt:g} s, "
+                             f"{fb.name}: {b.n} x {b.dt:g} s")
+        out.append((key, (a, b)))
+    return out
+
+
+def _check_dimensions(spec: StudySpec, racks: dict, records: list) -> None:
+    """Pairs of components and an incidence angle need 3D racks (the feature table). A
+    warehouse's 2D rows take the motion along their down-aisle axis (the executor projects it),
+    so a warehouse is not checked."""
+    from seisrack.model.features import require
+
+    if spec.warehouse is not None:
+        return
+    two = next((n for n, _, comps in records if len(comps) == 2), None)
+    for rack in racks.values():
+        if two is not None:
+            require("a cross-aisle ground motion component", rack.ndm, "records",
+                    f"{two} (a pair of components)")
+        if spec.angle.turns:
+            require("an incidence angle of the horizontal components", rack.ndm, "angle",
+                    spec.angle.values or f"{spec.angle.kind} {spec.angle.low:g}-"
+                    f"{spec.angle.high:g} deg")
 
 
 def _pattern(n: int, occupancy: float, seed: int, rack_hash: str) -> tuple[int, ...]:
@@ -248,6 +326,21 @@ def _check_reachable(name: str, rec: Record, im0: float, levels: tuple[float, ..
     except SeisrackError as exc:
         raise InputError("dt", dt, f"an analysis step dividing the time step of record {name} "
                          f"({rec.dt:g} s)", hint=str(exc)) from None
+
+
+def _angle_samples(spec: StudySpec, rack_hash: str, rec_hash: str,
+                   occupancy: float) -> list[float]:
+    """The incidence angles of one (rack, record, occupancy) [deg]: the listed values, or
+    uniform draws seeded by the cell (common to every intensity level)."""
+    a = spec.angle
+    if a.kind == "values":
+        return list(a.values)
+    out = []
+    for k in range(a.samples):
+        rng = np.random.default_rng(
+            [spec.seed, _seed_key("angle", rack_hash, rec_hash, occupancy), k])
+        out.append(float(a.low + (a.high - a.low) * rng.random()))
+    return out
 
 
 def _friction_samples(spec: StudySpec, rack_hash: str, rec_hash: str,

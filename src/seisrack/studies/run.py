@@ -30,6 +30,7 @@ from seisrack.errors import InputError
 from seisrack.studies.expand import Run, StudyPlan, curve_key, plan
 from seisrack.studies.spec import IdaStop, StudySpec
 from seisrack.studies.store import (
+    check_parts,
     part_files,
     read_runs,
     stored_run_ids,
@@ -58,6 +59,9 @@ class StudyRunSummary:
     executor: str
     workers: int
     part_files_written: int
+    #: part files found unreadable or foreign and moved to runs/quarantine/ (their runs were
+    #: recomputed): :meth:`seisrack.studies.store.SetAside.message` of each
+    parts_set_aside: tuple[str, ...] = ()
 
 
 def make_batches(runs: Sequence[Run], workers: int, batch_size: int | None = None,
@@ -127,7 +131,7 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
 
     executor: "local" (a process pool, ``workers`` processes, default one per core) or "dask"
     (a ``LocalCluster`` of ``workers`` processes, or the cluster at ``scheduler``, e.g.
-    ``"tcp://10.0.0.1:8786"``; giving ``scheduler`` implies "dask"). progress: a tqdm bar on
+    ``"tcp://SCHEDULER-HOST:8786"``; giving ``scheduler`` implies "dask"). progress: a tqdm bar on
     stderr with ETA and the running count of failures.
     """
     import os
@@ -146,6 +150,9 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
     out = Path(out_dir)
     if isinstance(spec, StudySpec):
         write_study_json(out, spec, pl.runs)
+    aside = check_parts(out)  # a damaged or foreign part never stops a resume
+    for a in aside:
+        log.warning("%s; they are run again", a.message())
     rule = pl.ida_stop
     pre_skipped: list[dict] = []
     if rule is None:
@@ -189,24 +196,27 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
                     parts += write_part(out, buffer) is not None
                     buffer, last = [], time.monotonic()
         finally:
-            # Ctrl-C or an error: keep every finished row (the part is written atomically)
-            parts += write_part(out, buffer) is not None
-            stream.close()
-            if bar is not None:
-                bar.close()
+            # Ctrl-C or an error: keep every finished row (the part is written atomically;
+            # on a full disk nothing is left half-written) and stop the workers in any case
+            try:
+                parts += write_part(out, buffer) is not None
+            finally:
+                stream.close()
+                if bar is not None:
+                    bar.close()
     return StudyRunSummary(out_dir=str(out), runs_total=len(pl.runs),
                            runs_already_stored=len(pl.runs) - n_missing,
                            runs_executed=ok + failed, runs_ok=ok, runs_failed=failed,
                            runs_skipped=skipped,
                            wall_time_s=time.perf_counter() - t0, executor=executor,
-                           workers=n_workers, part_files_written=parts)
+                           workers=n_workers, part_files_written=parts,
+                           parts_set_aside=tuple(a.message() for a in aside))
 
 
 def _bar(total: int, enabled: bool):  # noqa: ANN202
+    """Progress of the runs on stderr: a tqdm bar on a terminal, plain lines otherwise."""
     if not enabled:
         return None
-    try:
-        from tqdm.auto import tqdm
-    except ImportError:  # tqdm is in the [io]/[all] extras
-        return None
-    return tqdm(total=total, unit="run", desc="study", dynamic_ncols=True, smoothing=0.1)
+    from seisrack.progress import progress
+
+    return progress(total, "study", "run")

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
+from seisrack.limits import MAX_RECORD_SAMPLES, MAX_SUITE_COUNT
 from seisrack.model._reader import Table, check_number
 from seisrack.motion.records import G
 
@@ -27,7 +28,10 @@ DISTRIBUTIONS = ("lognormal", "uniform", "truncnormal")
 STOP_RULES = ("fall", "sliding")  # intensity.ida.stop_when
 DEFAULT_DT = 0.005  # s, analysis step
 DEFAULT_MAX_SCALE = 50.0  # largest scale factor accepted on a record
-_TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed")
+_TOP_KEYS = ("title", "racks", "records", "intensity", "friction", "occupancy", "dt", "seed",
+             "angle", "warehouse")
+#: the distributions of a sampled incidence angle
+ANGLE_DISTRIBUTIONS = ("uniform",)
 
 
 @dataclass(frozen=True)
@@ -41,14 +45,22 @@ class EC8Suite:
     count: int = 7
     seed: int = 0
     dt: float = 0.01  # [s] record time step
+    components: int = 1  # 2: each record is a pair of horizontal components (3D racks)
 
 
 @dataclass(frozen=True)
 class RecordsSpec:
-    """Where the records come from: a folder of files, bundled records, generated suites."""
+    """Where the records come from: a folder of files, bundled records, generated suites.
+
+    pairs: the folder's files are pairs of horizontal components (3D racks): files whose
+    names differ only by their last ``_``- or ``-``-separated token form a pair, the first by
+    name down-aisle, the second cross-aisle (PEER NGA: ``RSN6_IMPVALL.I_I-ELC180.AT2`` and
+    ``...-ELC270.AT2``).
+    """
 
     folder: str | None = None  # resolved path of the folder (AT2 / CSV / TXT files)
     folder_as_given: str | None = None
+    pairs: bool = False
     units: str | None = None  # units of CSV/TXT files without a header ("g" or "m/s2")
     file_dt: float | None = None  # [s] time step of one-column files
     builtin: tuple[str, ...] = ()
@@ -129,6 +141,24 @@ class FrictionSpec:
 
 
 @dataclass(frozen=True)
+class AngleSpec:
+    """The incidence angle of the horizontal components [deg] (3D racks): a list of values,
+    or ``samples`` draws per (rack, record, occupancy) from a uniform distribution on
+    [low, high]; every run of a draw sees the same angle at every intensity level."""
+
+    kind: str = "values"
+    values: tuple[float, ...] = (0.0,)
+    low: float = 0.0
+    high: float = 0.0
+    samples: int = 1
+
+    @property
+    def turns(self) -> bool:
+        """True when some run turns the motion (an angle other than 0)."""
+        return self.kind != "values" or any(v != 0.0 for v in self.values)
+
+
+@dataclass(frozen=True)
 class StudySpec:
     """A validated study. ``racks`` are resolved paths; ``racks_as_given`` as in the file."""
 
@@ -138,11 +168,16 @@ class StudySpec:
     intensity: IntensitySpec
     friction: FrictionSpec = FrictionSpec()
     occupancy: tuple[float, ...] = (1.0,)
+    angle: AngleSpec = AngleSpec()
     dt: float = DEFAULT_DT
     seed: int = 0
     title: str = ""
     source: str | None = None
     text: str = ""  # the study file as given (stored in study.json)
+    warehouse: Any = None  # a Warehouse (seisrack.studies.warehouse) instead of ``racks``
+    warehouse_as_given: str | None = None
+    #: per rack, the incidence angles [deg] of its warehouse rows (overrides ``angle``)
+    rack_angles: tuple[tuple[float, ...], ...] = ()
 
 
 def load_study(path: str | Path) -> StudySpec:
@@ -152,7 +187,7 @@ def load_study(path: str | Path) -> StudySpec:
         raise InputError("study", str(p), "an existing study TOML file")
     raw = p.read_bytes()
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a BOM (Windows Notepad) is fine
         data = tomllib.loads(text)
     except UnicodeDecodeError as exc:
         raise FileFormatError(str(p), f"not UTF-8 text ({exc.reason})") from None
@@ -167,6 +202,8 @@ def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None
     base = Path(base)
     root = Table(d, "", source)
     title = root.string("title", "")
+    if root.has("warehouse"):
+        return _warehouse_study(root, d, base, source, text, title)
     racks_raw = root.raw("racks")
     racks_list = [racks_raw] if isinstance(racks_raw, str) else racks_raw
     if not isinstance(racks_list, list) or not racks_list or not all(
@@ -187,12 +224,82 @@ def study_from_dict(d: Any, *, base: str | Path = ".", source: str | None = None
     intensity = _intensity(root.table("intensity"))
     friction = _friction(root.table("friction", {"values": [0.4]}))
     occupancy = _occupancy(root.table("occupancy", {}))
+    angle = _angle(root.table("angle", {}))
     dt = root.number("dt", DEFAULT_DT, positive=True, unit="s")
     seed = root.integer("seed", 0, minimum=0)
     root.finish(_TOP_KEYS)
     return StudySpec(racks=tuple(racks), racks_as_given=tuple(racks_list), records=records,
-                     intensity=intensity, friction=friction, occupancy=occupancy, dt=dt,
-                     seed=seed, title=title, source=source, text=text)
+                     intensity=intensity, friction=friction, occupancy=occupancy, angle=angle,
+                     dt=dt, seed=seed, title=title, source=source, text=text)
+
+
+def _warehouse_study(root: Table, d: Any, base: Path, source: str | None, text: str,
+                     title: str) -> StudySpec:
+    """A study of every rack row of a warehouse file (``warehouse = "site.toml"`` instead of
+    ``racks``): each group of rows is a rack run at its orientation (docs/user/
+    warehouse_toml.md); identical rows of a group see the same ground motion."""
+    from seisrack.studies.warehouse import load_warehouse
+
+    given = root.string("warehouse")
+    for key in ("racks", "angle"):
+        if root.has(key):
+            raise root.error(key, d[key], f"no '{key}' with 'warehouse' (the warehouse file "
+                             "gives the racks and their orientations)")
+    wp = base / given if not Path(given).is_absolute() else Path(given)
+    if not wp.is_file():
+        raise root.error("warehouse", given, f"an existing warehouse TOML file (looked for {wp})")
+    wh = load_warehouse(wp)
+    racks: list[str] = []  # as given in the warehouse file (labels of the runs)
+    paths: dict[str, str] = {}
+    angles: dict[str, list[float]] = {}
+    for row in wh.rows:
+        if row.rack_as_given not in angles:
+            racks.append(row.rack_as_given)
+            paths[row.rack_as_given] = str(Path(row.rack).resolve())
+            angles[row.rack_as_given] = []
+        # the motion in the rack's axes is the record pair turned by -orientation
+        a = -float(row.orientation_deg) + 0.0
+        if a not in angles[row.rack_as_given]:
+            angles[row.rack_as_given].append(a)
+    inner = {k: v for k, v in d.items() if k not in ("warehouse", "title")}
+    spec = study_from_dict({**inner, "racks": [paths[r] for r in racks],
+                            "title": title or wh.title}, base=base, source=source, text=text)
+    from dataclasses import replace
+
+    return replace(spec, racks_as_given=tuple(racks), warehouse=wh, warehouse_as_given=given,
+                   rack_angles=tuple(tuple(angles[r]) for r in racks))
+
+
+def _angle(t: Table) -> AngleSpec:
+    """``[angle]``: ``values = [deg, ...]`` or ``dist = "uniform"``, ``low``, ``high``,
+    ``samples`` (degrees, -360 to 360)."""
+    if t.has("values") and t.has("dist"):
+        raise t.error("values", t.data.get("values"), "one of 'values' (an array of angles "
+                      "[deg]) or 'dist' (\"uniform\" with low, high, samples), not both")
+
+    def degrees(v: Any, field: str) -> float:
+        x = check_number(v, field, unit="deg", source=t.source)
+        if not -360.0 <= x <= 360.0:
+            raise InputError(field, v, "an angle in degrees, -360 to 360", source=t.source)
+        return x
+
+    if t.has("dist"):
+        dist = t.string("dist")
+        if dist not in ANGLE_DISTRIBUTIONS:
+            raise t.error("dist", dist, ", ".join(f'"{d}"' for d in ANGLE_DISTRIBUTIONS))
+        low = degrees(t.raw("low", 0.0), t.field("low"))
+        high = degrees(t.raw("high"), t.field("high")) if t.has("high") else None
+        if high is None or high <= low:
+            raise t.error("high", t.data.get("high"), f"an angle > low ({low:g} deg)")
+        samples = t.integer("samples", 1, minimum=1)
+        t.finish(("dist", "low", "high", "samples"))
+        return AngleSpec(kind=dist, values=(), low=low, high=high, samples=samples)
+    raw = t.array("values", [0.0], min_len=1)
+    vals = tuple(degrees(v, f"{t.field('values')}[{i}]") for i, v in enumerate(raw))
+    if len(set(vals)) != len(vals):
+        raise t.error("values", raw, "distinct angles (an angle is listed twice)")
+    t.finish(("values",))
+    return AngleSpec(values=vals)
 
 
 def _records(t: Table, base: Path) -> RecordsSpec:
@@ -223,11 +330,17 @@ def _records(t: Table, base: Path) -> RecordsSpec:
     if not isinstance(ec8_list, list):
         raise t.error("ec8", ec8_raw, "a table or an array of tables [[records.ec8]]")
     ec8 = tuple(_ec8(Table(e, f"{t.field('ec8')}[{i}]", t.source)) for i, e in enumerate(ec8_list))
-    t.finish(("folder", "units", "dt", "builtin", "ec8"))
+    pairs = t.raw("pairs", False)
+    if not isinstance(pairs, bool):
+        raise t.error("pairs", pairs, "true or false")
+    if pairs and folder is None:
+        raise t.error("pairs", True, "pairs = true with a folder of record files (it groups "
+                      "the folder's files into pairs of horizontal components)")
+    t.finish(("folder", "units", "dt", "builtin", "ec8", "pairs"))
     if folder is None and not builtin and not ec8:
         raise t.error("<records>", {}, "at least one of folder, builtin, ec8")
-    return RecordsSpec(folder=folder, folder_as_given=folder_given, units=units, file_dt=file_dt,
-                       builtin=tuple(builtin), ec8=ec8)
+    return RecordsSpec(folder=folder, folder_as_given=folder_given, pairs=pairs, units=units,
+                       file_dt=file_dt, builtin=tuple(builtin), ec8=ec8)
 
 
 def _ec8(t: Table) -> EC8Suite:
@@ -240,8 +353,17 @@ def _ec8(t: Table) -> EC8Suite:
     s = EC8Suite(type=typ, ground=ground, ag=t.number("ag", 0.3, positive=True, unit="g"),
                  duration=t.number("duration", 10.0, positive=True, unit="s"),
                  count=t.integer("count", 7, minimum=1), seed=t.integer("seed", 0, minimum=0),
-                 dt=t.number("dt", 0.01, positive=True, unit="s"))
-    t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt"))
+                 dt=t.number("dt", 0.01, positive=True, unit="s"),
+                 components=t.integer("components", 1, minimum=1))
+    if s.components > 2:
+        raise t.error("components", s.components, "1 (one horizontal component) or 2 (a pair, "
+                      "for 3D racks)")
+    t.finish(("type", "ground", "ag", "duration", "count", "seed", "dt", "components"))
+    if s.count > MAX_SUITE_COUNT:
+        raise t.error("count", s.count, f"an integer from 1 to {MAX_SUITE_COUNT:,}")
+    if s.duration / s.dt > MAX_RECORD_SAMPLES:
+        raise t.error("duration", s.duration, f"a duration of at most {MAX_RECORD_SAMPLES:,} "
+                      f"time steps ({MAX_RECORD_SAMPLES * s.dt:g} s at dt = {s.dt:g} s)")
     return s
 
 

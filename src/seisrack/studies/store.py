@@ -13,6 +13,13 @@ stored. Each part is written under a temporary name in the same folder and renam
 ``os.replace`` (atomic on POSIX): a killed driver leaves complete part files only, and a
 resumed study reads the run ids already stored and runs the others.
 
+A part file that cannot be read (truncated by a full disk, damaged, or foreign: not written
+by this store) is never deleted and never stops a study: :func:`check_parts` moves it to
+``runs/quarantine/`` with a ``.reason.txt`` beside it, and names it; the runs it held are
+then missing from the store, so a resumed study recomputes them (:func:`run_study` calls it
+first). Readers that meet such a file later set it aside the same way and raise
+:class:`StoreError` naming it.
+
 :func:`read_runs` deduplicates by ``run_id`` (a run stored twice, e.g. by a driver killed
 between writing a part and noticing it, counts once) and sorts by ``run_id``. A run stored both
 as "skipped" (an IDA level above a stop rule's level) and as run (the rule was changed or
@@ -25,8 +32,12 @@ import hashlib
 import json
 import os
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from seisrack.atomic import atomic_write, write_text
+from seisrack.errors import SeisrackError
 
 #: row columns in order: (name, pyarrow type name)
 COLUMNS = (
@@ -39,9 +50,40 @@ COLUMNS = (
     ("base_shear_N", "float64"), ("beam_displacement_max_m", "float64"),
     ("drift_ratio_max", "float64"), ("upright_moment_connection_Nm", "float64"),
     ("wall_time_s", "float64"),
+    # the sliding reduction (issue 24): this run's and its rigid-pallet companion's peaks
+    ("connector_moment_Nm", "float64"), ("upright_moment_Nm", "float64"),
+    ("rigid_base_shear_N", "float64"), ("rigid_connector_moment_Nm", "float64"),
+    ("rigid_upright_moment_Nm", "float64"), ("rigid_alpha", "float64"),
+    # 3D racks (issue 21): the incidence angle, falls into the aisles, sliding per direction
+    ("angle_deg", "float64"), ("any_aisle_fall", "bool"), ("n_aisle_fall", "int64"),
+    ("peak_sliding_down_aisle_max_m", "float64"), ("peak_sliding_cross_aisle_max_m", "float64"),
 )
 RUNS_DIR = "runs"
 STUDY_JSON = "study.json"
+#: where unreadable or foreign part files are moved (inside ``runs/``; never deleted)
+QUARANTINE_DIR = "quarantine"
+#: columns a part file must hold, with the types of :data:`COLUMNS`, to be read: what defines
+#: a run and its outcome. Other columns may be missing (a store written before a column was
+#: added: read as nulls) but, when present, must have their type.
+REQUIRED = ("run_id", "rack", "record", "im_measure", "im_target", "scale_factor", "stripe",
+            "mu_static", "mu_dynamic", "occupancy", "seed", "status", "error")
+
+
+class StoreError(SeisrackError):
+    """A part file of the store could not be read (it was set aside: see :func:`check_parts`)."""
+
+
+@dataclass(frozen=True)
+class SetAside:
+    """A part file moved to ``runs/quarantine/``: where it was, where it is, and why."""
+
+    part: str
+    moved_to: str
+    reason: str
+
+    def message(self) -> str:
+        return (f"part file {self.part} {self.reason}: moved to {self.moved_to} (not deleted); "
+                "the runs it held are missing from the store")
 
 
 def schema():  # noqa: ANN201
@@ -71,15 +113,91 @@ def write_part(out_dir: str | Path, rows: list[dict[str, Any]]) -> Path | None:
     runs.mkdir(parents=True, exist_ok=True)
     digest = hashlib.sha256("\n".join(sorted(r["run_id"] for r in rows)).encode()).hexdigest()
     path = runs / f"part-{digest[:20]}.parquet"
-    tmp = runs / f".{path.name}.{os.getpid()}.tmp"
-    pq.write_table(rows_to_table(rows), tmp)
-    os.replace(tmp, path)
-    return path
+    table = rows_to_table(rows)
+    return atomic_write(path, lambda tmp: pq.write_table(table, tmp))
 
 
 def part_files(out_dir: str | Path) -> list[Path]:
     runs = Path(out_dir) / RUNS_DIR
     return sorted(runs.glob("part-*.parquet")) if runs.is_dir() else []
+
+
+def check_parts(out_dir: str | Path) -> list[SetAside]:
+    """Check every part file (its footer, schema, and ``run_id`` / ``status`` columns) and
+    move each one that cannot be read, or is foreign, to ``runs/quarantine/``.
+
+    Returns what was set aside (empty when the store is sound). Raises :class:`StoreError`
+    when a bad file cannot even be moved (e.g. a read-only folder).
+    """
+    import pyarrow.parquet as pq
+
+    sch = schema()
+    out = []
+    for p in part_files(out_dir):
+        try:
+            reason = _foreign(pq.read_schema(p), sch)
+            if reason is None:
+                pq.read_table(p, columns=["run_id", "status"])
+        except MemoryError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - pyarrow's many errors: the file is bad
+            reason = f"cannot be read ({_why(exc)})"
+        if reason is not None:
+            out.append(_set_aside(p, reason))
+    return out
+
+
+def _foreign(got: Any, sch: Any) -> str | None:
+    """Why a part file's schema is not this store's (None if it is)."""
+    names = set(got.names)
+    missing = [c for c in REQUIRED if c not in names]
+    if missing:
+        return f"is not a seisrack study part (no column {', '.join(missing[:4])})"
+    for f in sch:
+        if f.name in names and not got.field(f.name).type.equals(f.type):
+            return (f"is not a seisrack study part (column {f.name} is "
+                    f"{got.field(f.name).type}, not {f.type})")
+    return None
+
+
+def _why(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    text = text.replace(str(exc.filename), "") if getattr(exc, "filename", None) else text
+    return f"{type(exc).__name__}: {text[:200]}" if text else type(exc).__name__
+
+
+def _set_aside(p: Path, reason: str) -> SetAside:
+    """Move ``p`` to ``runs/quarantine/`` (a new name if taken) with a note of ``reason``."""
+    q = p.parent / QUARANTINE_DIR
+    dest = q / p.name
+    k = 1
+    while dest.exists():
+        dest, k = q / f"{p.name}.{k}", k + 1
+    try:
+        q.mkdir(exist_ok=True)
+        os.replace(p, dest)
+    except OSError as exc:
+        raise StoreError(f"part file {p} {reason}, and it cannot be moved aside to {q} "
+                         f"({exc.strerror or exc}): move it out of {p.parent} yourself, then "
+                         "run the command again (its runs are recomputed)") from None
+    try:
+        write_text(dest.with_name(dest.name + ".reason.txt"), f"{p}: {reason}\n")
+    except OSError:  # the file itself is safe; the note is a courtesy
+        pass
+    return SetAside(part=str(p), moved_to=str(dest), reason=reason)
+
+
+def _read_part(p: Path, **kw: Any):  # noqa: ANN202
+    """``pq.read_table(p, **kw)``; a bad file is set aside and :class:`StoreError` raised."""
+    import pyarrow.parquet as pq
+
+    try:
+        return pq.read_table(p, **kw)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - pyarrow's many errors: the file is bad
+        aside = _set_aside(p, f"cannot be read ({_why(exc)})")
+    raise StoreError(aside.message() + "; run the study again to recompute them")
 
 
 def stored_run_ids(out_dir: str | Path, *, skipped: bool = True) -> set[str]:
@@ -88,14 +206,12 @@ def stored_run_ids(out_dir: str | Path, *, skipped: bool = True) -> set[str]:
     skipped: False leaves out the runs stored only as "skipped" (IDA levels above a stop rule's
     level: not run).
     """
-    import pyarrow.parquet as pq
-
     ids: set[str] = set()
     for p in part_files(out_dir):
         if skipped:
-            ids.update(pq.read_table(p, columns=["run_id"]).column(0).to_pylist())
+            ids.update(_read_part(p, columns=["run_id"]).column(0).to_pylist())
             continue
-        t = pq.read_table(p, columns=["run_id", "status"]).to_pydict()
+        t = _read_part(p, columns=["run_id", "status"]).to_pydict()
         ids.update(i for i, st in zip(t["run_id"], t["status"], strict=True)
                    if st != "skipped")
     return ids
@@ -110,13 +226,12 @@ def read_runs(out_dir: str | Path, columns: list[str] | None = None):  # noqa: A
     import numpy as np
     import pyarrow as pa
     import pyarrow.compute as pc
-    import pyarrow.parquet as pq
 
     sch = schema()
     if columns is not None:
         keep = {"run_id", "status", *columns}
         sch = pa.schema([f for f in sch if f.name in keep])
-    parts = [pq.read_table(p, schema=sch, columns=sch.names) for p in part_files(out_dir)]
+    parts = [_read_part(p, schema=sch, columns=sch.names) for p in part_files(out_dir)]
     if not parts:
         return sch.empty_table()
     table = pa.concat_tables(parts)
@@ -153,8 +268,13 @@ def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa
                                         if spec.intensity.ida_stop else None)},
         "runs": [asdict(r) for r in runs],
     }
-    path = out / STUDY_JSON
-    tmp = out / f".{STUDY_JSON}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps(doc, indent=1, allow_nan=True))
-    os.replace(tmp, path)
-    return path
+    wh = getattr(spec, "warehouse", None)
+    if wh is not None:
+        doc["warehouse"] = {"file": spec.warehouse_as_given, "path": wh.source,
+                            "title": wh.title,
+                            "groups": [{"name": r.name, "rack": r.rack_as_given, "count": r.count,
+                                        "orientation_deg": r.orientation_deg,
+                                        "angle_deg": -float(r.orientation_deg) + 0.0,
+                                        "n_pallets": r.n_pallets, "three_d": r.three_d}
+                                       for r in wh.rows]}
+    return write_text(out / STUDY_JSON, json.dumps(doc, indent=1, allow_nan=True))

@@ -25,20 +25,21 @@ Theta is in the units of the intensity measure as stored: m/s² for both PGA and
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import logging
 import math
-import sys
 from collections import Counter
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from seisrack.errors import InputError, SeisrackError
+from seisrack.atomic import atomic_write, save_figure, write_text
+from seisrack.errors import InputError
 from seisrack.studies import fragility as fr
+from seisrack.studies.reduction_summary import COLUMNS as REDUCTION_COLUMNS
+from seisrack.studies.reduction_summary import format_reduction, reduction_summary
 
 __all__ = ["DEFAULT_D_SLIDE", "read_runs_table", "runs_as_arrays", "summarize", "summary_main"]
 
@@ -48,7 +49,11 @@ DEFAULT_D_SLIDE = (0.05,)  # [m]
 PEAKS = ("peak_sliding_max_m", "n_fall", "base_shear_N", "beam_displacement_max_m",
          "drift_ratio_max", "upright_moment_connection_Nm")
 _STR = ("run_id", "rack", "record", "im_measure", "status", "error")
-_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS
+#: the columns of a 3D rack's runs (NaN or False for a 2D rack's, or in an older store)
+COLUMNS_3D = ("angle_deg", "any_aisle_fall", "n_aisle_fall", "peak_sliding_down_aisle_max_m",
+              "peak_sliding_cross_aisle_max_m")
+_NUM = ("im_target", "stripe", "mu_static", "mu_dynamic", "occupancy", "any_fall") + PEAKS \
+    + tuple(c for c in REDUCTION_COLUMNS if c not in PEAKS) + COLUMNS_3D
 CSV_FIELDS = ("name", "theta", "beta", "theta_lo", "theta_hi", "beta_lo", "beta_hi",
               "n_stripes", "n_runs", "rack", "im_measure", "method", "status")
 
@@ -111,6 +116,16 @@ def _damage_states(d_slide, shear_capacity) -> list[tuple[str, str, float]]:
     return states
 
 
+def _damage_states_3d(d_slide) -> list[tuple[str, str, float]]:
+    """The states of a 3D rack's runs: a pallet falls into an aisle, and the sliding along
+    each direction beyond each threshold."""
+    states = [("aisle_fall", "any_aisle_fall", 0.5)]
+    for name in ("down_aisle", "cross_aisle"):
+        states += [(f"sliding_{name}>{d:g}m", f"peak_sliding_{name}_max_m", float(d))
+                   for d in d_slide]
+    return states
+
+
 def _nan(x: float) -> float | None:
     return None if x is None or not math.isfinite(x) else float(x)
 
@@ -134,7 +149,9 @@ def _peaks(r: dict[str, np.ndarray], idx: np.ndarray) -> dict[str, Any]:
     recs = r["record"][idx]
     names = sorted(set(recs))
     out: dict[str, Any] = {}
-    for c in PEAKS:
+    extra = tuple(c for c in ("n_aisle_fall", "peak_sliding_cross_aisle_max_m")
+                  if c in r and np.any(np.isfinite(r[c][idx].astype(float))))  # 3D racks
+    for c in PEAKS + extra:
         per_rec = np.array([np.nanmean(r[c][idx][recs == nm]) if np.any(
             np.isfinite(r[c][idx][recs == nm])) else math.nan for nm in names])
         per_rec = per_rec[np.isfinite(per_rec)]
@@ -178,20 +195,24 @@ def _stripes(r, idx, states, n_boot, seed) -> dict[str, Any]:
 
 def _ida(r, idx, states, n_boot, seed) -> dict[str, Any]:
     ok = idx[r["status"][idx] == "ok"]
-    keys = sorted({(r["record"][i], r["mu_static"][i], r["mu_dynamic"][i], r["occupancy"][i])
-                   for i in ok})
+    # an older store has no angle column (NaN): every curve at 0°
+    angle = np.nan_to_num(r["angle_deg"], nan=0.0)
+    keys = sorted({(r["record"][i], r["mu_static"][i], r["mu_dynamic"][i], r["occupancy"][i],
+                    angle[i]) for i in ok})
     curves = []
-    for rec, mu_s, mu_d, occ in keys:
-        rows = ok[(r["record"][ok] == rec) & (r["mu_static"][ok] == mu_s)
-                  & (r["mu_dynamic"][ok] == mu_d) & (r["occupancy"][ok] == occ)]
+    for rec, mu_s, mu_d, occ, ang in keys:
+        def same(rows: np.ndarray) -> np.ndarray:
+            return ((r["record"][rows] == rec) & (r["mu_static"][rows] == mu_s)  # noqa: B023
+                    & (r["mu_dynamic"][rows] == mu_d) & (r["occupancy"][rows] == occ)  # noqa: B023
+                    & (angle[rows] == ang))  # noqa: B023
+
+        rows = ok[same(ok)]
         rows = rows[np.argsort(r["im_target"][rows], kind="stable")]
-        skip = idx[(r["status"][idx] == "skipped") & (r["record"][idx] == rec)
-                   & (r["mu_static"][idx] == mu_s) & (r["mu_dynamic"][idx] == mu_d)
-                   & (r["occupancy"][idx] == occ)]
+        skip = idx[(r["status"][idx] == "skipped") & same(idx)]
         cv = {"record": rec, "mu_static": _nan(mu_s), "occupancy": _nan(occ),
-              "im": r["im_target"][rows].tolist(),
+              "angle_deg": float(ang), "im": r["im_target"][rows].tolist(),
               "stopped_im": float(r["im_target"][skip].min()) if skip.size else None}
-        for c in PEAKS + ("any_fall",):
+        for c in PEAKS + ("any_fall",) + COLUMNS_3D:
             cv[c] = [_nan(v) for v in r[c][rows]]
         curves.append(cv)
     fits = {}
@@ -215,13 +236,15 @@ def _capacity(cv: dict[str, Any], col: str, thr: float) -> float:
 
 def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: float | None = None,
               n_boot: int = 200, seed: int = 0, write: bool = True, plots: bool = True,
-              boots: list | None = None) -> dict[str, Any]:
+              boots: list | None = None, hazard: str | Path | None = None) -> dict[str, Any]:
     """Summary of the study stored in ``out_dir`` (see the module docstring).
 
     d_slide: sliding thresholds [m] (a float or a sequence); shear_capacity: base shear [N] for
     the ``base_shear>V`` damage state (omitted when None); n_boot: bootstrap resamples per fit;
     boots: a list that receives ``(rack, im_measure, kind, state, (thetas, betas))`` per fit
-    (the bootstrap samples, for the bands of the HTML report).
+    (the bootstrap samples, for the bands of the HTML report); hazard: a site hazard curve CSV
+    in the study's intensity measure: adds ``risk`` (mean annual frequency and 50-year
+    probability of each fitted fragility, :mod:`seisrack.studies.risk`).
     Returns the dict written to ``summary.json``.
     """
     out = Path(out_dir)
@@ -233,12 +256,25 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
     if shear_capacity is not None and not (shear_capacity > 0):
         raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
+    from seisrack.studies.store import StoreError, check_parts
+
+    aside = check_parts(out)
+    if aside:
+        raise StoreError("; ".join(a.message() for a in aside) + f". Run the study again "
+                         f"(seisrack study STUDY.toml --out {out}) to recompute them, then "
+                         "summarise it")
     table = read_runs_table(out)
     if table.num_rows == 0:
         raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
                          hint="The study has no finished run yet; run or resume it first")
     r = runs_as_arrays(table)
+    curve = None
+    if hazard is not None:  # checked before any fit
+        from seisrack.studies.risk import load_hazard_curve
+
+        curve = load_hazard_curve(hazard, tuple(sorted(set(r["im_measure"]))))
     states = _damage_states(d_slide, shear_capacity)
+    states_3d = _damage_states_3d(d_slide)
     status = r["status"]
     failed = status == "failed"
     reasons = Counter((e.splitlines()[0][:160] if e else "(no reason recorded)")
@@ -250,19 +286,29 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         "failure_reasons": dict(reasons.most_common()),
         "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
         "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
-        "fragility": [],
+        "fragility": [], "warnings": _missing_runs(out, int(status.size)),
     }
     groups = sorted({(a, b) for a, b in zip(r["rack"], r["im_measure"], strict=True)})
     boot_store = []
     for rack, meas in groups:
         idx = np.flatnonzero((r["rack"] == rack) & (r["im_measure"] == meas))
         g: dict[str, Any] = {"rack": rack, "im_measure": meas}
+        three_d = bool(np.isfinite(r["peak_sliding_cross_aisle_max_m"][idx]).any())
+        g_states = states + (states_3d if three_d else [])
+        if three_d:
+            g["dimension"] = "3D"
+            for name, *_ in states_3d:
+                if name not in summary["damage_states"]:
+                    summary["damage_states"].append(name)
         ms = idx[r["stripe"][idx] >= 0]
         ida = idx[r["stripe"][idx] < 0]
         if ms.size:
-            g["stripes"] = _stripes(r, ms, states, n_boot, seed)
+            g["stripes"] = _stripes(r, ms, g_states, n_boot, seed)
         if ida.size:
-            g["ida"] = _ida(r, ida, states, n_boot, seed)
+            g["ida"] = _ida(r, ida, g_states, n_boot, seed)
+        red = reduction_summary(r, idx)
+        if red is not None:
+            g["sliding_reduction"] = red
         for kind in ("stripes", "ida"):
             for name, f in g.get(kind, {}).get("fragility", {}).items():
                 boot_store.append((rack, meas, kind, name, f.pop("_boot", None)))
@@ -270,6 +316,23 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
                 summary["fragility"].append({"name": name, "rack": rack, "im_measure": meas,
                                              "analysis": kind, **row})
         summary["groups"].append(g)
+    if curve is not None:
+        from seisrack.studies.risk import risk_summary
+
+        summary["risk"] = {"file": str(hazard), **risk_summary(curve, summary["fragility"])}
+    from seisrack.studies.warehouse_summary import warehouse_groups, warehouse_summary
+
+    wh = warehouse_groups(out)
+    if wh is not None and "unreadable" in wh:
+        summary["notes"] = [wh["unreadable"] + ": if the study is of a warehouse, its section "
+                            "is missing; run the study command again to rewrite the file "
+                            "(nothing is rerun)"]
+    elif wh is not None:
+        summary["warehouse"] = {**warehouse_summary(r, wh), "path": wh.get("path")}
+        if hazard is not None:
+            from seisrack.studies.warehouse_summary import annual_falls
+
+            summary["warehouse"]["per_year"] = annual_falls(summary["warehouse"], curve)
     if boots is not None:
         boots.extend(boot_store)
     if write:
@@ -277,20 +340,43 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     return summary
 
 
+def _missing_runs(out: Path, n_stored: int) -> list[str]:
+    """A warning when the store holds fewer runs than ``study.json`` lists (an interrupted
+    study, or part files set aside): the statistics then describe part of the study."""
+    try:
+        n_planned = len(json.loads((out / "study.json").read_text(encoding="utf-8"))["runs"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return []
+    if n_stored >= n_planned:
+        return []
+    return [f"the store holds {n_stored} of the study's {n_planned} runs: the statistics "
+            f"describe part of the study; run it again (seisrack study STUDY.toml --out "
+            f"{out}) to complete it"]
+
+
 def _write(folder: Path, summary: dict[str, Any], *, plots: bool, boots) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     files = {"summary_json": str(folder / "summary.json"),
              "fragility_csv": str(folder / "fragility.csv")}
-    with open(folder / "fragility.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
-        w.writeheader()
-        for row in summary["fragility"]:
-            w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in w.fieldnames})
+    def write_csv(path: Path) -> None:
+        with open(path, "w", newline="", encoding="utf-8") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(CSV_FIELDS) + ["analysis"])
+            w.writeheader()
+            for row in summary["fragility"]:
+                w.writerow({k: ("" if row.get(k) is None else row.get(k))
+                            for k in w.fieldnames})
+
+    atomic_write(folder / "fragility.csv", write_csv)
     if plots:
         files.update(_figures(folder, summary, boots))
+        if "warehouse" in summary:
+            from seisrack.studies.warehouse_summary import plan_figures
+
+            files.update(plan_figures(folder, summary["warehouse"],
+                                      summary["warehouse"].get("path")))
     summary["files"] = files
-    (folder / "summary.json").write_text(json.dumps(_jsonable(summary), indent=1,
-                                                    allow_nan=False))
+    write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=1,
+                                                   allow_nan=False))
 
 
 def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
@@ -317,10 +403,11 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                 theta = math.nan if f["theta"] is None else f["theta"]
                 beta = math.nan if f["beta"] is None else f["beta"]
                 plot_fragility(im, frac, theta, beta, band=band, grid=grid, label=name,
-                               im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
+                               im_label=f"{g['im_measure'].upper()} [m/s²]",
+                               status=f.get("status"), ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "fragility.png", dpi=120)
+        save_figure(fig, folder / "fragility.png", dpi=120)
         plt.close(fig)
         files["fragility_png"] = str(folder / "fragility.png")
     ida = [g for g in summary["groups"] if "ida" in g]
@@ -331,9 +418,13 @@ def _figures(folder: Path, summary: dict[str, Any], boots) -> dict[str, str]:
                      threshold=summary["d_slide_m"][0], ax=ax)
             ax.set_title(Path(g["rack"]).name, fontsize="small")
         fig.tight_layout()
-        fig.savefig(folder / "ida.png", dpi=120)
+        save_figure(fig, folder / "ida.png", dpi=120)
         plt.close(fig)
         files["ida_png"] = str(folder / "ida.png")
+    from seisrack.report.study_figures import save_reduction_figure, save_risk_figure
+
+    files.update(save_reduction_figure(folder, summary))
+    files.update(save_risk_figure(folder, summary))
     return files
 
 
@@ -356,7 +447,8 @@ def _fmt(x: Any, spec: str = ".3g") -> str:
 
 def format_summary(s: dict[str, Any]) -> str:
     """A readable text summary of :func:`summarize`'s result."""
-    lines = [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
+    lines = [f"warning: {w}" for w in s.get("warnings", [])]
+    lines += [f"study {s['out_dir']}: {s['runs_total']} runs, {s['runs_ok']} ok, "
              f"{s['runs_failed']} failed" + (f", {s['runs_skipped']} skipped (IDA stop rule)"
                                               if s.get("runs_skipped") else "")]
     for reason, n in s["failure_reasons"].items():
@@ -364,16 +456,23 @@ def format_summary(s: dict[str, Any]) -> str:
     for g in s["groups"]:
         lines.append(f"\nrack {g['rack']}, IM = {g['im_measure']} [m/s²]")
         if "stripes" in g:
-            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  falls (mean)")
+            three_d = g.get("dimension") == "3D"
+            # at risk: down-aisle sliding reached the free distance (pallets_at_risk)
+            lines.append("  stripe      IM   ok/runs  records  sliding mean/max [m]  at risk (mean)"
+                         + ("  fell into an aisle (mean)" if three_d else ""))
             for st in g["stripes"]["stripes"]:
                 pk = st["peaks"]["peak_sliding_max_m"]
                 nf = st["peaks"]["n_fall"]
+                na = st["peaks"].get("n_aisle_fall") or {"mean": None}
                 lines.append(f"  {st['stripe']:6d} {st['im']:7.3g} "
                              f"{st['n_ok']:4d}/{st['n_runs']:<4d} {st['n_records']:7d}  "
                              f"{_fmt(pk['mean']):>9} / {_fmt(pk['max']):<9}"
-                             f" {_fmt(nf['mean'])}")
+                             f" {_fmt(nf['mean']):>14}"
+                             + (f"  {_fmt(na['mean']):>26}" if three_d else ""))
         if "ida" in g:
             lines.append(f"  IDA: {len(g['ida']['curves'])} curves")
+        if "sliding_reduction" in g:
+            lines += format_reduction(g["sliding_reduction"])
     lines.append("\nfragility (theta [m/s²], beta; 90 % bootstrap band)")
     for f in s["fragility"]:
         lines.append(f"  {f['analysis']:7s} {f['name']:22s} theta {_fmt(f['theta']):>7} "
@@ -394,57 +493,23 @@ def format_summary(s: dict[str, Any]) -> str:
     }
     seen = [st for st in notes if any(f["status"] == st for f in s["fragility"])]
     lines += [f"  note: {notes[st]}" for st in seen]
+    if "risk" in s:
+        from seisrack.studies.risk import format_risk
+
+        lines += format_risk(s["risk"])
+    lines += [f"\nnote: {n}" for n in s.get("notes", [])]
+    if "warehouse" in s:
+        from seisrack.studies.warehouse_summary import format_warehouse
+
+        lines += format_warehouse(s["warehouse"])
     if "files" in s:
         lines.append("\nwritten: " + ", ".join(s["files"].values()))
     return "\n".join(lines)
 
 
 def summary_main(argv: list[str]) -> int:
-    """``seisrack study summary DIR [--d-slide D ...] [--shear-capacity N] [--boot N] [--json]
-    [--report FILE.html [--force]]``."""
-    p = argparse.ArgumentParser(prog="seisrack study summary",
-                                description="Summarise a study: counts, EC8 means, fragility.")
-    p.add_argument("dir", help="the study output folder (--out of `seisrack study`)")
-    p.add_argument("--d-slide", type=float, nargs="+", default=list(DEFAULT_D_SLIDE),
-                   metavar="D", help="sliding thresholds [m] (default 0.05)")
-    p.add_argument("--shear-capacity", type=float, default=None, metavar="N",
-                   help="base shear capacity [N] for the 'base shear > capacity' state")
-    p.add_argument("--boot", type=int, default=200, metavar="N", help="bootstrap resamples")
-    p.add_argument("--seed", type=int, default=0, help="bootstrap seed")
-    p.add_argument("--no-plots", action="store_true", help="skip the figures")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--report", metavar="FILE.html", default=None,
-                   help="also write the study's self-contained HTML report")
-    p.add_argument("--force", action="store_true", help="overwrite an existing --report")
-    try:
-        a = p.parse_args(argv)
-    except SystemExit as exc:  # argparse already printed its usage message
-        return int(exc.code or 0)
-    if a.boot < 0:
-        print("error: --boot must be >= 0", file=sys.stderr)
-        return 2
-    boots: list = []
-    try:
-        if a.report:  # refuse an existing report before any work
-            from seisrack.report.html import check_report_path
+    """``seisrack study summary DIR ...`` (see :mod:`seisrack.cli.study_summary`), with the
+    command line's error contract: exit 2 and one paragraph (a JSON object under ``--json``)."""
+    from seisrack.cli import main
 
-            check_report_path(a.report, a.force, field="--report")
-        s = summarize(a.dir, d_slide=a.d_slide, shear_capacity=a.shear_capacity,
-                      n_boot=a.boot, seed=a.seed, plots=not a.no_plots, boots=boots)
-        if a.report:
-            from seisrack.report.html import write_study_report
-
-            html = write_study_report(a.report, _jsonable(s), out_dir=a.dir, boots=boots,
-                                      seed=a.seed, force=a.force)
-            s.setdefault("files", {})["report_html"] = str(html)
-    except SeisrackError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (OSError, ImportError, ValueError) as exc:  # unreadable part files
-        print(f"error: could not read the study in {a.dir}: {exc}", file=sys.stderr)
-        return 2
-    if a.json:
-        print(json.dumps(_jsonable(s), allow_nan=False))
-    else:
-        print(format_summary(s))
-    return 0
+    return main(["study", "summary", *argv])

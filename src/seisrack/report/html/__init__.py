@@ -22,7 +22,8 @@ __all__ = ["build_html", "build_study_html", "write_html_report", "write_study_r
 
 def check_report_path(path: str | os.PathLike[str], force: bool = False,
                       field: str = "path") -> Path:
-    """Refuse an existing report without ``force`` and an unwritable place, before any work."""
+    """Refuse an existing report without ``force`` and an unwritable place, before any work;
+    create the report's folder if needed."""
     p = Path(path)
     if p.is_dir():
         raise InputError(field, str(p), "a file name for the HTML report (this is a folder)")
@@ -30,9 +31,14 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
         raise InputError(field, str(p), "a path that does not exist yet",
                          hint="The report exists; pass force=True (--force) to overwrite it")
     parent = p.parent if str(p.parent) else Path(".")
-    if not parent.is_dir():
-        raise InputError(field, str(p), "a path in an existing folder",
-                         hint=f"Create the folder {parent} first")
+    if parent.exists() and not parent.is_dir():
+        raise InputError(field, str(p), "a path in a folder",
+                         hint=f"{parent} is a file, not a folder")
+    try:  # created if needed, as `seisrack run --out DIR` does
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(field, str(p), "a path in a folder that can be created",
+                         hint=f"{parent}: {exc.strerror or exc}") from None
     if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
         raise InputError(field, str(p), "a writable path",
                          hint=f"Permission denied in {parent}")
@@ -42,12 +48,11 @@ def check_report_path(path: str | os.PathLike[str], force: bool = False,
 def write_atomically(p: Path, text: str) -> Path:
     """Write ``text`` to a temporary file beside ``p``, then rename it: a reader never sees a
     half-written report, and a failed write leaves what was there."""
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    from seisrack.atomic import write_text
+
     try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, p)
+        write_text(p, text)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         raise InputError("path", str(p), "a writable path",
                          hint=str(exc.strerror or exc)) from None
     return p
@@ -57,13 +62,16 @@ def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, re
                       record: Any, summary: dict[str, Any], modal: Any = None,
                       checks: dict[str, Any] | None = None, force: bool = False,
                       design_spectrum: Any = None, rack_file: str | None = None,
-                      seed: int | None = None, interactive: bool | None = None) -> Path:
+                      seed: int | None = None, interactive: bool | None = None,
+                      design_section: dict[str, Any] | None = None) -> Path:
     """Write the HTML report of ``response`` (a RackResponse of ``model`` under ``record``).
 
     summary: the dict written to summary.json (the tables show its numbers exactly);
     modal: ModalResult (modal section skipped if None); checks: the result of
     :func:`seisrack.checks.run_design_checks`; design_spectrum: EC8 spectrum drawn against the
-    record's spectrum; interactive: use plotly (default: if installed).
+    record's spectrum; interactive: use plotly (default: if installed); design_section: the
+    keyword arguments of :func:`seisrack.report.html.design.design_section_html` (the design
+    analysis and the sliding reduction), section omitted if None.
     Raises InputError if ``path`` exists (without ``force``) or cannot be written.
     """
     p = check_report_path(path, force)
@@ -71,5 +79,5 @@ def write_html_report(path: str | os.PathLike[str], *, spec: Any, model: Any, re
                       summary=summary, modal=modal, checks=checks,
                       design_spectrum=design_spectrum, rack_file=rack_file, seed=seed,
                       interactive=interactive, date=_dt.datetime.now().isoformat(
-                          timespec="seconds"))
+                          timespec="seconds"), design_section=design_section)
     return write_atomically(p, text)

@@ -46,16 +46,17 @@ def plot_elevation(model: Any, spec: Any, peak_sliding: np.ndarray, utilisation:
 
     ax = _axes(ax, (8.0, 5.0))
     mesh = model.mesh
-    for i, j in mesh.elements:
-        ax.plot(*mesh.nodes[[i, j]].T, color="0.35", lw=1.6, zorder=1)
-    base = mesh.nodes[model.base_nodes]
+    front = np.asarray(model.element_side) == 0  # a 3D rack: its front frame, in elevation
+    for i, j in mesh.elements[front]:
+        ax.plot(*mesh.nodes[[i, j]][:, :2].T, color="0.35", lw=1.6, zorder=1)
+    base = mesh.nodes[model.base_nodes[np.asarray(model.column_side) == 0]]
     ax.plot(base[:, 0], base[:, 1], "k^", ms=8, clip_on=False, zorder=2)
     mm = 1e3 * np.asarray(peak_sliding, dtype=float)
     vmax = float(mm.max()) if mm.size and mm.max() > 0 else 1.0
     norm = mpl.colors.Normalize(vmin=0.0, vmax=vmax)
     cmap = mpl.colormaps["viridis"]
     pallets = list(getattr(spec, "pallets", []) or [])
-    node_xy = mesh.nodes[model.pallet_node]
+    node_xy = mesh.nodes[model.pallet_node[:, 0]][:, :2]
     for j in range(model.n_pallets):
         w = float(getattr(pallets[j], "width", 1.0)) if j < len(pallets) else 1.0
         x, y = node_xy[j]
@@ -77,40 +78,55 @@ def plot_elevation(model: Any, spec: Any, peak_sliding: np.ndarray, utilisation:
 
 def plot_modes(model: Any, modal: Any, n_shapes: int = 3) -> Any:
     """A figure with the first ``n_shapes`` mode shapes (returns the Figure)."""
+    from seisrack.report.frame_plot import modes_figure
+
+    return modes_figure(model, modal, n_shapes)
+
+
+def components(motion: Any) -> list[tuple[str, str, np.ndarray]]:
+    """(direction, record name, acceleration [m/s²]) of each component of a
+    :class:`~seisrack.motion.components.GroundMotion` as run: down-aisle, then cross-aisle and
+    vertical when there are."""
+    out = [("down-aisle", motion.names[0], motion.x)]
+    if motion.z is not None:
+        out.append(("cross-aisle", motion.names[1] or "-", motion.z))
+    if motion.v is not None:
+        out.append(("vertical", motion.names[2], motion.v))
+    return out
+
+
+def plot_record(motion: Any) -> Any:
+    """Ground acceleration [m/s²] against time [s], one panel per component. Returns the
+    Figure."""
     import matplotlib.pyplot as plt
 
-    from seisrack.report.frame_plot import plot_mode_shape
-
-    n = max(1, min(n_shapes, modal.n_modes))
-    fig, axes = plt.subplots(1, n, figsize=(3.6 * n, 3.6), squeeze=False)
-    for k in range(n):
-        ax = plot_mode_shape(model, modal, k + 1, axes[0, k])
-        ax.title.set_fontsize(8)
+    comps = components(motion)
+    fig, axes = plt.subplots(len(comps), 1, figsize=(8.0, 2.3 * len(comps)), squeeze=False,
+                             sharex=True)
+    t = np.arange(motion.n) * motion.dt
+    for ax, (direction, name, a) in zip(axes[:, 0], comps, strict=True):
+        ax.plot(t, a, lw=0.7, color="tab:blue")
+        ax.set_ylabel("[m/s²]")
+        ax.set_title(f"{direction}: {name}", fontsize=9)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()
     return fig
 
 
-def plot_record(record: Any, ax: Any = None) -> Any:
-    """Ground acceleration of the record [m/s²] against time [s]."""
-    ax = _axes(ax, (8.0, 2.6))
-    t = np.arange(record.n) * record.dt
-    ax.plot(t, record.accel, lw=0.7, color="tab:blue")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("ground acceleration [m/s²]")
-    ax.grid(alpha=0.3)
-    return ax
-
-
-def plot_spectra(record: Any, ax: Any = None, *, design: Any = None, periods_rack: Any = None,
+def plot_spectra(motion: Any, ax: Any = None, *, design: Any = None, periods_rack: Any = None,
                  damping: float = 0.05) -> Any:
-    """5 %-damped pseudo-acceleration spectrum of the record [m/s²], with the design spectrum
-    and the rack's periods (vertical lines) when given."""
+    """5 %-damped pseudo-acceleration spectrum of each horizontal component [m/s²], with the
+    design spectrum and the rack's periods (vertical lines) when given."""
     from seisrack.motion import response_spectrum
 
     ax = _axes(ax, (7.0, 3.6))
     T = np.geomspace(0.02, 4.0, 120)
-    sp = response_spectrum(record.accel, record.dt, T, damping)
-    ax.plot(T, sp.psa, color="tab:blue", label=f"record {record.name} ({100 * damping:g} %)")
+    for k, (direction, name, a) in enumerate(components(motion)):
+        if direction == "vertical":
+            continue
+        sp = response_spectrum(a, motion.dt, T, damping)
+        ax.plot(T, sp.psa, color=f"C{k}", label=f"{direction} {name} ({100 * damping:g} %)")
     if design is not None:
         ax.plot(T, design.psa(T), "k--", label=getattr(design, "name", "design spectrum"))
     if periods_rack is not None:

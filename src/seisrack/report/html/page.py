@@ -9,6 +9,7 @@ import numpy as np
 from seisrack import __version__
 from seisrack.report.html import figures as F
 from seisrack.report.html.connections import connections_html
+from seisrack.report.html.design import design_section_html
 from seisrack.report.html.style import CSS
 from seisrack.report.html.tables import (
     esc,
@@ -25,7 +26,10 @@ N_WORST = 5
 KNOWN_KEYS = {"record", "g_m_s2", "dt_s", "duration_s", "status", "peaks", "sliding_occurred",
               "pallets_at_risk", "pallets", "simplified_check", "n_events", "n_slip_events",
               "energy_balance_error", "rack", "title", "integration", "basis", "scaling",
-              "outputs", "design_checks", "modal", "report", "seed", "hinges"}
+              "outputs", "design_checks", "modal", "report", "seed", "hinges",
+              "design_analysis", "sliding_reduction", "dimension", "directions", "impacts",
+              "falls", "falls_by_level", "pallets_falling", "pallets_checked_for_falls",
+              "angle_deg", "notes", "design", "energy_J", "work", "warnings"}
 
 
 def _figure(fig_id: str, src: str, caption: str) -> str:
@@ -42,18 +46,24 @@ def _plotly_available() -> bool:
 
 
 def _histories(response: Any) -> list[tuple[str, str, np.ndarray, dict[str, np.ndarray]]]:
+    """Top-level displacement and base shear in every direction, the sliding of the pallets
+    that slid most (along each direction where there are two)."""
     t = np.asarray(response.t)
-    top = np.asarray(response.beam_displacement)[:, -1] * 1e3
+    dirs = response.directions
+    top = response.directional("beam_displacement")[:, -1, :] * 1e3
+    shear = response.directional("base_shear") / 1e3
     series = [("Top beam level: displacement relative to the ground", "displacement [mm]", t,
-               {"top level": top}),
+               {d: top[:, k] for k, d in enumerate(dirs)}),
               ("Base shear (sum of the support reactions)", "base shear [kN]", t,
-               {"base shear": np.asarray(response.base_shear) / 1e3})]
+               {d: shear[:, k] for k, d in enumerate(dirs)})]
     if response.n_pallets:
         worst = np.argsort(-response.pallet_peak_sliding())[:N_WORST]
-        series.append((f"Sliding of the {len(worst)} pallets that slid most, relative to the "
-                       "beam", "sliding [mm]", t,
-                       {f"pallet {j + 1}": np.asarray(response.pallet_sliding)[:, j] * 1e3
-                        for j in worst}))
+        sliding = response.directional("pallet_sliding") * 1e3
+        for k, d in enumerate(dirs):
+            where = f" ({d})" if len(dirs) > 1 else ""
+            series.append((f"Sliding of the {len(worst)} pallets that slid most, relative to "
+                           f"the beam{where}", "sliding [mm]", t,
+                           {f"pallet {j + 1}": sliding[:, j, k] for j in worst}))
     return series
 
 
@@ -61,7 +71,8 @@ def _history_html(response: Any, interactive: bool) -> tuple[str, str]:
     """(head script, body html) of the time-history section."""
     series = _histories(response)
     cap = ("Time histories [s]: top-level displacement [mm], base shear [kN] and the sliding "
-           f"[mm] of the {N_WORST} pallets that slid most (kept samples of the run).")
+           f"[mm] of the {N_WORST} pallets that slid most (kept samples of the run)"
+           + (", in each horizontal direction." if response.n_dir > 1 else "."))
     if not interactive:
         return "", _figure("fig-histories", F.png_data_uri(F.plot_histories_static(series)), cap)
     import plotly.graph_objects as go
@@ -83,12 +94,19 @@ def _history_html(response: Any, interactive: bool) -> tuple[str, str]:
     return head, body
 
 
-def _inputs(spec: Any, record: Any, summary: dict[str, Any], rack_file: str | None,
+def _inputs(spec: Any, motion: Any, summary: dict[str, Any], rack_file: str | None,
             seed: int | None, date: str, response: Any) -> str:
     items = [("rack file", rack_file or summary.get("rack", "–")),
              ("rack", getattr(spec, "title", "") or "–"),
-             ("record", f"{record.name}: {record.n} samples, dt {record.dt:g} s, "
-                        f"PGA {record.pga:.4g} m/s² = {record.pga / 9.80665:.3f} g")]
+             ("dimension", f"{summary.get('dimension', '2D')} rack, directions "
+                           + ", ".join(response.directions))]
+    for direction, name, a in F.components(motion):
+        pga = float(np.max(np.abs(a)))
+        items.append((f"record ({direction})",
+                      f"{name}: {motion.n} samples, dt {motion.dt:g} s, PGA {pga:.4g} m/s² = "
+                      f"{pga / 9.80665:.3f} g"))
+    if motion.z is not None:
+        items.append(("incidence angle", f"{motion.angle_deg:g}°"))
     sc = summary.get("scaling")
     items.append(("scaling", ", ".join(f"{k} = {v}" for k, v in sc.items())
                   if isinstance(sc, dict) else "none (record as given)"))
@@ -102,19 +120,27 @@ def _inputs(spec: Any, record: Any, summary: dict[str, Any], rack_file: str | No
 
 
 def _modal_html(model: Any, modal: Any) -> str:
+    planar = modal.mass_participation_z is not None  # a 3D rack: cross-aisle and torsion too
     rows = []
     for k in range(modal.n_modes):
-        rows.append(f"<tr><td>{k + 1}</td>" + num_cell(float(modal.periods[k]), 1, "{:.4f}")
-                    + num_cell(float(modal.frequencies[k]), 1, "{:.3f}")
-                    + num_cell(float(modal.gamma_x[k]), 1, "{:.4g}")
-                    + num_cell(float(modal.mass_participation[k]) * 100, 1, "{:.2f}")
-                    + num_cell(float(np.sum(modal.mass_participation[:k + 1])) * 100, 1,
-                               "{:.2f}") + "</tr>")
+        cells = (num_cell(float(modal.periods[k]), 1, "{:.4f}")
+                 + num_cell(float(modal.frequencies[k]), 1, "{:.3f}")
+                 + num_cell(float(modal.gamma_x[k]), 1, "{:.4g}")
+                 + num_cell(float(modal.mass_participation[k]) * 100, 1, "{:.2f}")
+                 + num_cell(float(np.sum(modal.mass_participation[:k + 1])) * 100, 1, "{:.2f}"))
+        if planar:
+            cells += (num_cell(float(modal.mass_participation_z[k]) * 100, 1, "{:.2f}")
+                      + num_cell(float(modal.participation_theta[k]) * 100, 1, "{:.2f}")
+                      + f"<td>{esc(modal.direction[k])}</td>")
+        rows.append(f"<tr><td>{k + 1}</td>{cells}</tr>")
+    extra = ("<th>cross-aisle mass [%]</th><th>plan rotation [%]</th><th>class</th>"
+             if planar else "")
     tab = ('<table id="table-modal"><caption>Natural modes with the pallets rigidly held: '
-           "period, frequency, horizontal participation factor Γ and effective mass share."
-           "</caption><thead><tr><th>mode</th><th>period T [s]</th><th>frequency [Hz]</th>"
-           "<th>Γx [kg^0.5]</th><th>horizontal mass [%]</th><th>cumulative [%]</th></tr>"
-           f"</thead><tbody>{''.join(rows)}</tbody></table>")
+           "period, frequency, down-aisle participation factor Γ and effective mass share"
+           + (", cross-aisle and plan-rotation shares and each mode's class" if planar else "")
+           + ".</caption><thead><tr><th>mode</th><th>period T [s]</th><th>frequency [Hz]</th>"
+           "<th>Γx [kg^0.5]</th><th>down-aisle mass [%]</th><th>cumulative [%]</th>"
+           f"{extra}</tr></thead><tbody>{''.join(rows)}</tbody></table>")
     fig = _figure("fig-modes", F.png_data_uri(F.plot_modes(model, modal)),
                   "First mode shapes (blue) over the undeformed rack (grey), x and y [m]; "
                   "displacements scaled to 15 % of the rack's size.")
@@ -139,7 +165,8 @@ def _checks_html(checks: dict[str, Any]) -> str:
             out.append(f"<p><small>{esc(cmp_['note'])}</small></p>")
         if c["name"] == "drift_sensitivity_ec8":
             out.append(_rows_table(f"table-{c['name']}", c["storeys"], [
-                ("storey", "storey", 1, "{}"), ("height_m", "h [m]", 1, "{:.3f}"),
+                ("storey", "storey", 1, "{}"), ("direction", "direction", 1, "{}"),
+                ("height_m", "h [m]", 1, "{:.3f}"),
                 ("P_tot_N", "P_tot [kN]", 1e-3, "{:.2f}"), ("drift_m", "d_r [mm]", 1e3, "{:.2f}"),
                 ("V_tot_N", "V_tot [kN]", 1e-3, "{:.2f}"), ("theta", "θ [-]", 1, "{:.3f}"),
                 ("verdict", "verdict", 1, "{}")], "θ per storey from the time history."))
@@ -157,7 +184,7 @@ def _checks_html(checks: dict[str, Any]) -> str:
                 ("id", "pallet", 1, "{}"), ("level", "level", 1, "{}"),
                 ("mu_static", "μ static [-]", 1, "{:.3f}"), ("alpha", "α [-]", 1, "{:.3f}"),
                 ("slides_predicted", "predicted to slide", 1, "{}")],
-                "Per pallet: α = peak beam acceleration / g of the pallet's level."))
+                "Per pallet: α = peak horizontal beam acceleration / g of the pallet's level."))
         out.append("</div>")
     if checks.get("disagreements"):
         out.insert(0, '<div class="disagree"><b>Checks that disagree with the time history:'
@@ -184,44 +211,96 @@ def _rows_table(tid: str, rows: list[dict[str, Any]], cols: list[tuple[str, str,
             f"</thead><tbody>{body}</tbody></table>")
 
 
+def _falls_html(summary: dict[str, Any]) -> str:
+    """Falls into the aisles (3D racks) and down-aisle impacts, one row each."""
+    out = []
+    falls = summary.get("falls")
+    if falls is not None:
+        rows = [f'<tr data-fall="{f["pallet"]}"><td>{f["pallet"]}</td><td>{esc(f["label"])}</td>'
+                f"<td>{f['level']}</td><td>{f['bay']}</td>" + num_cell(f["time_s"], 1, "{:.3f}",
+                                                                       "time_s")
+                + f"<td>{esc(f['side'])}</td></tr>" for f in falls]
+        flue = sum(1 for f in falls if f["side"] == "flue")
+        out.append('<table id="table-falls"><caption>Pallets falling off the beams (first '
+                   f"crossing of the overhang), {len(falls)} of "
+                   f"{summary.get('pallets_checked_for_falls', 0)} checked"
+                   + (f", {flue} of them into the flue between the rows" if flue else
+                      ", each into an aisle")
+                   + ". The model keeps a "
+                   "fallen pallet on its beams: its sliding after the fall is not physical."
+                   "</caption><thead><tr><th>pallet</th><th>label</th><th>level</th><th>bay</th>"
+                   "<th>time [s]</th><th>side</th></tr></thead><tbody>"
+                   + "".join(rows) + "</tbody></table>")
+    impacts = summary.get("impacts") or []
+    rows = [f"<tr><td>{esc(i['contact'])}</td>" + num_cell(i["time_s"], 1, "{:.3f}", "time_s")
+            + num_cell(i["closing_speed_m_s"], 1, "{:.3f}", "closing_speed_m_s") + "</tr>"
+            for i in impacts]
+    out.append('<table id="table-impacts"><caption>Down-aisle impacts: first contact of a '
+               f"pallet with its neighbour or an upright ({len(impacts)}).</caption><thead><tr>"
+               "<th>contact</th><th>time [s]</th><th>closing speed [m/s]</th></tr></thead>"
+               "<tbody>" + "".join(rows) + "</tbody></table>")
+    return "".join(out)
+
+
 def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: dict[str, Any],
                modal: Any = None, checks: dict[str, Any] | None = None,
                design_spectrum: Any = None, rack_file: str | None = None,
-               seed: int | None = None, interactive: bool | None = None, date: str = "") -> str:
-    """The report as one HTML string (see :func:`write_html_report`)."""
+               seed: int | None = None, interactive: bool | None = None, date: str = "",
+               design_section: dict[str, Any] | None = None) -> str:
+    """The report as one HTML string (see :func:`write_html_report`). ``record``: the ground
+    motion as run, a Record (down-aisle) or a GroundMotion (with cross-aisle and vertical
+    components on a 3D rack)."""
     import matplotlib
 
+    from seisrack.motion.components import GroundMotion, combine
+
     matplotlib.use("Agg")
+    motion = record if isinstance(record, GroundMotion) else combine(record)
     if interactive is None:
         interactive = _plotly_available()
     title = getattr(spec, "title", "") or summary.get("title") or "rack"
     peak = response.pallet_peak_sliding()
     util = response.fall_utilisation()
-    ax = F.plot_elevation(model, spec, peak, util)
+    fell = np.zeros(response.n_pallets, dtype=bool)
+    fell[[f.pallet for f in response.falls]] = True
+    ax = F.plot_elevation(model, spec, peak, np.where(fell, np.inf, util))
     n_risk = int(np.sum(util >= 1.0))
+    n_fall = int(fell.sum())
+    planar = response.n_dir > 1
     sec = []
     sec.append(f'<section id="inputs"><h2>1. Inputs</h2>'
-               f"{_inputs(spec, record, summary, rack_file, seed, date, response)}</section>")
-    sec.append('<section id="elevation"><h2>2. Rack elevation and pallet sliding</h2>'
+               f"{_inputs(spec, motion, summary, rack_file, seed, date, response)}</section>")
+    plan = ""
+    if planar and response.n_pallets:
+        from seisrack.report.sliding_paths import plot_sliding_paths
+
+        plan = _figure("fig-plan", F.png_data_uri(plot_sliding_paths(response, model)),
+                       "Plan view of each loaded beam level, x down-aisle and z cross-aisle "
+                       "[m]: each pallet's footprint and the path of its centre (magnified as "
+                       "the panel title says); dashed: its fall limits; red: it falls.")
+    sec.append('<section id="elevation"><h2>2. Rack elevation, plan and pallet sliding</h2>'
                + _figure("fig-elevation", F.png_data_uri(ax.figure),
-                         "Elevation of the rack, x and height [m]: each pallet drawn at its "
-                         "position and coloured by its peak sliding on the beam [mm] (colour "
-                         "bar); pallet numbers are the 1-based ids of the tables; red hatched "
-                         f"pallets reached their free distance (may fall): {n_risk}.")
-               + "</section>")
+                         "Elevation of the rack" + (" (front frame)" if planar else "")
+                         + ", x and height [m]: each pallet drawn at its position and coloured "
+                         "by its peak sliding on the beams [mm] (colour bar"
+                         + ("; the magnitude of the sliding vector" if planar else "")
+                         + "); pallet numbers are the 1-based ids of the tables; red hatched "
+                         f"pallets reached their free distance down-aisle ({n_risk})"
+                         + (f" or fell into an aisle ({n_fall})" if planar else "") + ".")
+               + plan + _falls_html(summary) + "</section>")
     if modal is not None:
         sec.append('<section id="modal"><h2>3. Modal analysis</h2>'
                    + _modal_html(model, modal) + "</section>")
-    rec_ax = F.plot_record(record)
-    sp_ax = F.plot_spectra(record, design=design_spectrum,
+    rec_fig = F.plot_record(motion)
+    sp_ax = F.plot_spectra(motion, design=design_spectrum,
                            periods_rack=None if modal is None else modal.periods)
     sec.append('<section id="record"><h2>4. Ground motion</h2>'
-               + _figure("fig-record", F.png_data_uri(rec_ax.figure),
-                         f"Horizontal ground acceleration of {record.name} [m/s²] against time "
-                         "[s], as applied (after any scaling).")
+               + _figure("fig-record", F.png_data_uri(rec_fig),
+                         f"Ground acceleration of {motion.name} [m/s²] against time [s], each "
+                         "component as applied (after any scaling and rotation).")
                + _figure("fig-spectrum", F.png_data_uri(sp_ax.figure),
-                         "5 %-damped pseudo-acceleration response spectrum of the record "
-                         "[m/s²] against period [s]"
+                         "5 %-damped pseudo-acceleration response spectrum of each horizontal "
+                         "component [m/s²] against period [s]"
                          + (f", with the design spectrum ({design_spectrum.name})"
                             if design_spectrum is not None else
                             " (no design spectrum given)")
@@ -240,9 +319,13 @@ def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: di
     if checks is not None:
         sec.append(f'<section id="checks"><h2>{8 if conn else 7}. Design checks beside the '
                    "time history</h2>" + _checks_html(checks) + "</section>")
-    verdict = (f"{n_risk} pallet(s) may fall" if n_risk else "no pallet reached its free "
-               "distance") + ("; pallets slid" if summary.get("sliding_occurred") else
-                              "; no sliding")
+    if design_section:
+        sec.append(design_section_html(7 + bool(conn) + (checks is not None), **design_section))
+    verdict = (f"{n_risk} pallet(s) reached their free distance down-aisle" if n_risk else
+               "no pallet reached its free distance down-aisle") + (
+        (f"; {n_fall} pallet(s) fall into an aisle" if n_fall else "; no pallet falls into an "
+         "aisle") if planar else "") + ("; pallets slid" if summary.get("sliding_occurred")
+                                        else "; no sliding")
     if summary.get("hinges"):
         verdict += f"; {summary['hinges']['yielded']} connection hinge(s) yielded"
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
@@ -250,5 +333,17 @@ def build_html(*, spec: Any, model: Any, response: Any, record: Any, summary: di
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<style>{CSS}</style>{head}</head><body>"
             f"<h1>Earthquake response of {esc(title)}</h1>"
-            f'<p class="summary-line">Record {esc(record.name)}: {esc(verdict)}.</p>'
-            + "".join(sec) + "</body></html>\n")
+            f'<p class="summary-line">Record {esc(motion.name)}: {esc(verdict)}.</p>'
+            + _warnings_html(summary.get("warnings") or []) + "".join(sec)
+            + "</body></html>\n")
+
+
+def _warnings_html(warnings: list[dict[str, Any]]) -> str:
+    """The plausibility warnings (:mod:`seisrack.checks.plausibility`), first thing a reader
+    sees after the verdict."""
+    if not warnings:
+        return ""
+    items = "".join(f'<li data-code="{esc(w.get("code", ""))}">{esc(w["message"])} '
+                    f'<i>({esc(w.get("source", ""))})</i></li>' for w in warnings)
+    return (f'<div class="disagree" id="warnings"><b>Plausibility warnings: a reviewer would '
+            f"question these results.</b><ul>{items}</ul></div>")

@@ -228,7 +228,7 @@ def _fit_text(f: dict[str, Any]) -> str:
 def _fragility_figures(gi: int, g: dict[str, Any], boots: dict) -> str:
     import matplotlib.pyplot as plt
 
-    from seisrack.report.fragility_plot import plot_fragility
+    from seisrack.report.fragility_plot import fit_is_drawable, plot_fragility
 
     st = g["stripes"]["stripes"]
     im = np.array([s["im"] for s in st], dtype=float)
@@ -241,16 +241,21 @@ def _fragility_figures(gi: int, g: dict[str, Any], boots: dict) -> str:
         _, ax = plt.subplots(figsize=(6.4, 4.0))
         plot_fragility(im, [nan(s["fraction"].get(name)) for s in st], nan(f.get("theta")),
                        nan(f.get("beta")), band=band, grid=grid, label=f"{name}: fitted",
-                       im_label=f"{g['im_measure'].upper()} [m/s²]", ax=ax)
+                       im_label=f"{g['im_measure'].upper()} [m/s²]", status=f.get("status"),
+                       ax=ax)
+        drawn = fit_is_drawable(nan(f.get("theta")), nan(f.get("beta")), f.get("status"))
         _g_axis(ax)
         ax.grid(alpha=0.3)
         ax.set_title(f"{Path(g['rack']).name}: {name}", fontsize="small")
         cap = (f"Fragility of {g['rack']} for {name}: probability of exceedance [-] against "
                f"{g['im_measure'].upper()} [m/s²] (top axis in g). Circles: observed fraction "
-               "of ok runs per stripe; line: fitted lognormal (binomial maximum likelihood, "
-               "Baker 2015 Eq. 11), " + _fit_text(f) + "; shaded: "
-               + ("5-95 % bootstrap band." if band is not None else
-                  "no bootstrap band (no bootstrap samples available)."))
+               "of ok runs per stripe; "
+               + ("line: fitted lognormal (binomial maximum likelihood, Baker 2015 Eq. 11), "
+                  + _fit_text(f) + "; shaded: "
+                  + ("5-95 % bootstrap band." if band is not None else
+                     "no bootstrap band (no bootstrap samples available).") if drawn else
+                  "dashed: the observed fractions joined; no fitted curve is drawn because "
+                  + _fit_text(f) + "."))
         out.append(_figure(f"fig-fragility-{gi}-{di}", F.png_data_uri(ax.figure), cap))
     return "".join(out)
 
@@ -286,7 +291,7 @@ def _ida_html(gi: int, g: dict[str, Any], summary: dict[str, Any]) -> str:
                        math.nan if f.get("theta") is None else f["theta"],
                        math.nan if f.get("beta") is None else f["beta"], grid=grid,
                        label=f"{name}: fitted", im_label=f"{g['im_measure'].upper()} [m/s²]",
-                       ax=ax)
+                       status=f.get("status"), ax=ax)
         _g_axis(ax)
         ax.grid(alpha=0.3)
         out.append(_figure(f"fig-ida-fragility-{gi}-{di}", F.png_data_uri(ax.figure),
@@ -360,6 +365,14 @@ def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = 
     if ida:
         sec.append('<section id="ida"><h2>6. Incremental dynamic analysis</h2>'
                    + "".join(ida) + "</section>")
+    from seisrack.report.html.study_extra import (
+        reduction_section,
+        risk_section,
+        warehouse_section,
+    )
+
+    sec += [s for s in (reduction_section(summary, 7), risk_section(summary, 8),
+                        warehouse_section(summary, 9)) if s]
     line = (f"{summary.get('runs_total')} runs, {summary.get('runs_ok')} ok, "
             f"{summary.get('runs_failed')} failed.")
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"

@@ -14,12 +14,12 @@ PALLET_COLUMNS: list[tuple[str, str, float, str]] = [
     ("mu_static", "μ static [-]", 1.0, "{:.3f}"),
     ("mu_dynamic", "μ dynamic [-]", 1.0, "{:.3f}"),
     ("peak_sliding_m", "peak sliding [mm]", 1e3, "{:.3f}"),
-    ("residual_m", "residual [mm]", 1e3, "{:.3f}"),
+    ("residual_m", "residual [mm] (x / z)", 1e3, "{:.3f}"),
     ("limit_neg_m", "free distance −x [mm]", 1e3, "{:.1f}"),
     ("limit_pos_m", "free distance +x [mm]", 1e3, "{:.1f}"),
     ("fall_utilisation", "sliding / free distance [-]", 1.0, "{:.3f}"),
 ]
-_SKIP_PALLET = {"label", "id", "sliding_phases"}
+_SKIP_PALLET = {"label", "id", "sliding_phases", "falls"}
 
 
 def esc(x: Any) -> str:
@@ -46,13 +46,23 @@ def header_of(key: str) -> str:
     return f"{name.replace('_', ' ')} [{unit}]"
 
 
+def _shown(value: float, factor: float, fmt: str) -> str:
+    return "∞" if math.isinf(value) else ("–" if value != value else fmt.format(value * factor))
+
+
 def num_cell(value: Any, factor: float = 1.0, fmt: str = "{:.4g}", key: str = "") -> str:
-    """A <td> whose data-value is the exact JSON text of ``value``."""
+    """A <td> whose data-value is the exact JSON text of ``value``: a number, or a list of
+    numbers (one per horizontal direction, shown "x / z")."""
+    if isinstance(value, list) and value and all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+        shown = " / ".join(_shown(v, factor, fmt) for v in value)
+        return (f'<td class="num" data-key="{esc(key)}" data-value="{esc(json.dumps(value))}">'
+                f"{shown}</td>")
     if isinstance(value, bool) or not isinstance(value, int | float):
         return f'<td data-key="{esc(key)}">{esc(value)}</td>'
     raw = json.dumps(value)
-    shown = "∞" if math.isinf(value) else ("–" if value != value else fmt.format(value * factor))
-    return f'<td class="num" data-key="{esc(key)}" data-value="{esc(raw)}">{shown}</td>'
+    return (f'<td class="num" data-key="{esc(key)}" data-value="{esc(raw)}">'
+            f"{_shown(value, factor, fmt)}</td>")
 
 
 def pallet_table(summary: dict[str, Any]) -> str:
@@ -69,12 +79,14 @@ def pallet_table(summary: dict[str, Any]) -> str:
                   for k, _, f, fmt in PALLET_COLUMNS]
         cells += [num_cell(p[k], _unit_factor(k)[1], "{:.4g}", k) if k in p else "<td>–</td>"
                   for k in extra]
-        cls = ' class="risk"' if p.get("fall_utilisation", 0) >= 1 else ""
+        cls = ' class="risk"' if p.get("fall_utilisation", 0) >= 1 or p.get("falls") else ""
         rows.append(f'<tr{cls} data-pallet="{j}">' + "".join(cells) + "</tr>")
     return _table_rows("table-pallets", headers, rows,
                        "Per pallet: sliding relative to the beam (peak over every analysis "
-                       "step), residual at the end, free distance on each side and utilisation "
-                       "(>= 1: the pallet may fall). Red rows: at risk.")
+                       "step; on a 3D rack the magnitude, and each direction), residual at the "
+                       "end, free distance down-aisle on each side and utilisation (>= 1: it "
+                       "reached a neighbour or an upright), fall limits cross-aisle. Red rows: "
+                       "at risk or falling.")
 
 
 def _table_rows(table_id: str, headers: list[str], rows: list[str], caption: str) -> str:
@@ -97,7 +109,8 @@ def level_table(summary: dict[str, Any], level_y: Any) -> str:
         rows.append(f'<tr data-level="{i}">' + "".join(cells) + "</tr>")
     return _table_rows("table-levels", headers, rows,
                        "Per beam level: peaks over every analysis step (absolute acceleration, "
-                       "displacement relative to the ground, total pallet-beam contact force).")
+                       "displacement relative to the ground, total pallet-beam contact force; "
+                       "down-aisle / cross-aisle on a 3D rack).")
 
 
 def peaks_table(summary: dict[str, Any]) -> str:

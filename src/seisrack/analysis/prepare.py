@@ -1,0 +1,113 @@
+"""What every run of one compiled rack shares, prepared once: :func:`prepare_run`.
+
+The basis the engine integrates in (:func:`seisrack.dynamics.run_basis.choose_basis`: every mode
+of a small rack, a load-dependent Ritz basis of a large one), the recovery and design operators
+projected onto it, and the rack's hinges. A study runs one model under many records and
+frictions: it prepares once and hands the :class:`PreparedRun` to every
+:func:`~seisrack.analysis.run_rack`. Friction does not enter what is prepared, so a run may use a
+model whose pallet friction differs from the prepared one's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+
+from seisrack.analysis.hinges import rack_hinges
+from seisrack.analysis.peaks import RackOperators, rack_operators
+from seisrack.dynamics import PlanarSliders, Sliders
+from seisrack.dynamics.basis import Basis
+from seisrack.dynamics.hinges import Hinges
+from seisrack.dynamics.run_basis import choose_basis
+from seisrack.errors import InputError
+from seisrack.model.frame_model import FrameModel
+
+#: friction coefficient of the companion run with rigidly held pallets
+RIGID_MU = 1.0e6
+
+
+@dataclass(frozen=True)
+class PreparedRun:
+    """The shared part of the runs of one rack (arrays read-only).
+
+    basis: the engine's basis; ops: the rack operators projected onto it; hinges: the rack's
+    nonlinear hinges (None when every connection is elastic); vertical: whether the basis holds
+    the vertical load (runs with a vertical component); n_dof: the model's size (checked).
+    """
+
+    basis: Basis
+    ops: RackOperators
+    hinges: Hinges | None
+    vertical: bool
+    n_dof: int
+
+
+def rack_sliders(model: FrameModel, mu: float | None = None) -> Sliders | PlanarSliders:
+    """The pallets of ``model`` as the engine's sliders: along a line when the rack has one
+    horizontal direction (their supports' down-aisle DOF), in the plane when it has two (their
+    front and rear supports' x and z DOFs). ``mu`` replaces every friction coefficient (the
+    rigid companion run)."""
+    mus = model.pallet_mu_static if mu is None else mu
+    mud = model.pallet_mu_dynamic if mu is None else mu
+    d = model.pallet_dofs
+    if model.n_dir == 1:
+        return Sliders(d[:, 0, 0], model.pallet_mass, mus, mud,
+                       model.pallet_friction_rate if mu is None else 0.0)
+    return PlanarSliders(d[:, :, 0], d[:, :, 1], model.pallet_mass, mus, mud)
+
+
+def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: bool = False,
+                design: bool = True) -> PreparedRun:
+    """The :class:`PreparedRun` of ``model`` (cached per model for a named basis: a compiled
+    model is immutable, so the cache cannot go stale)."""
+    if isinstance(basis, Basis):
+        return _prepare(model, basis, vertical, design)
+    if basis not in ("auto", "full", "reduced"):
+        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    cache = _model_cache(model)
+    key = (basis, bool(vertical), bool(design))
+    hit = cache.get(key)
+    if hit is None:
+        hit = cache[key] = _prepare(model, basis, vertical, design)
+    return hit
+
+
+def _prepare(model: FrameModel, basis: str | Basis, vertical: bool, design: bool
+             ) -> PreparedRun:
+    hinges = rack_hinges(model)
+    bas = choose_basis(basis, model.M_sparse, model.K_sparse, rack_sliders(model),
+                       model.influence, rv=model.r_y if vertical else None, hinges=hinges)
+    return _locked(PreparedRun(basis=bas, ops=rack_operators(model, bas.phi, design=design),
+                               hinges=hinges, vertical=vertical, n_dof=model.n_dof))
+
+
+#: per compiled model (weakly held: dropped with the model), its prepared runs
+_MODEL_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _model_cache(model: FrameModel) -> dict:
+    try:
+        return _MODEL_CACHE.setdefault(model, {})
+    except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
+        return {}
+
+
+def _locked(obj):  # noqa: ANN001, ANN202
+    """``obj`` with its arrays (through dataclass fields, tuples and dict values, recursively)
+    made read-only, since it is shared by every run of a model (returned as is)."""
+
+    def lock(x) -> None:  # noqa: ANN001
+        if isinstance(x, np.ndarray):
+            x.flags.writeable = False
+        elif isinstance(x, dict | tuple):
+            for v in (x.values() if isinstance(x, dict) else x):
+                lock(v)
+        elif dataclasses.is_dataclass(x) and not isinstance(x, type):
+            for f in dataclasses.fields(x):
+                lock(getattr(x, f.name))
+
+    lock(obj)
+    return obj

@@ -1,0 +1,212 @@
+"""The scheme for sliders moving along one line (2D racks, :class:`~seisrack.dynamics.Sliders`):
+the chunk loop around the exact and the Newmark kernels (``_kernel_exact.py``, ``_kernel.py``),
+called by :func:`seisrack.dynamics.simulate` once the inputs are checked. Theory:
+``docs/theory/stick_slip_engine.md``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+
+import numpy as np
+
+from seisrack.dynamics import _inputs as chk
+from seisrack.dynamics._blas import one_blas_thread
+from seisrack.dynamics._chunk import Chunk
+from seisrack.dynamics._setup import (
+    _check_friction_rate,
+    _check_memory,
+    _exact_unsupported,
+    _kept_samples,
+    _load_patterns,
+    _stiffness_proportional,
+)
+from seisrack.dynamics._store import Buffers as _Buffers
+from seisrack.dynamics._store import Kept as _Kept
+from seisrack.dynamics.basis import Basis
+from seisrack.dynamics.hinges import Hinges, energy_split
+from seisrack.dynamics.kernels import get_kernel
+from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
+from seisrack.dynamics.run_basis import choose_basis
+from seisrack.dynamics.sliders import Sliders
+from seisrack.errors import InputError, SolverError
+
+_LOG = logging.getLogger(__name__)
+
+#: cap on sub-steps (event splits) inside one time step; slip-onset chatter with mu_d = mu_s
+#: can produce dozens of micro-events in one step on multi-pallet racks
+_MAX_SUBSTEPS = 512
+
+_STATUS = {
+    0: "ok",
+    1: "event buffer overflow (increase max_events)",
+    2: "too many events inside one step (reduce dt)",
+    3: "non-finite response (check the input)",
+    4: "equilibrium iterations (hinges, velocity-dependent friction) did not converge "
+       "(reduce dt)",
+}
+
+
+def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarray,  # noqa: ANN001, N803
+             r: np.ndarray, F: np.ndarray | None, av: np.ndarray | None,  # noqa: N803
+             rv: np.ndarray | None, g: float, q_u0: np.ndarray, q_v0: np.ndarray,
+             backend: str, track_energy: bool, max_events: int, throw: bool,
+             progress: Callable[[int], None] | None, chunk: int, method: str,
+             basis: str | Basis, save_every: int | None,
+             on_chunk: Callable[[Chunk], None] | None, max_memory: float | None,
+             hinges: Hinges) -> TimeHistory:
+    """Integrate the checked inputs of :func:`seisrack.dynamics.simulate` (see there)."""
+    n_t = n_steps + 1
+    m = sliders.count
+    nonlinear = hinges.nonlinear or sliders.velocity_dependent
+    bas = choose_basis(basis, M, K, sliders, [r], rv=rv, F=F, hinges=hinges)
+    phi, w2 = bas.phi, bas.w2
+    nb = w2.shape[0]
+    n_keep = _kept_samples(n_steps, save_every)
+    _check_memory(n_keep, chunk, nb, m + hinges.count, n_t, max_memory)
+
+    cq = phi.T @ (C @ phi)
+    off = cq - np.diag(np.diag(cq))
+    diag = bool(np.max(np.abs(off)) <= 1e-10 * max(np.max(np.abs(np.diag(cq))), 1e-300))
+    cd = np.diag(cq).copy() if diag else np.zeros(nb)
+    Cq = np.zeros((1, 1)) if diag else np.ascontiguousarray(cq)
+    # load split p(t) = series(t) @ pat in basis coordinates (few patterns when possible)
+    pat, series = _load_patterns(phi, M, r, ag, F, av, rv)
+    gz = g + (av if av is not None else np.zeros(n_t))
+    on_structure = sliders.dof >= 0
+    P = np.zeros((m, nb))  # maps basis coordinates to each slider's support (zero: on the ground)
+    P[on_structure] = phi[sliders.dof[on_structure], :]
+    q0 = phi.T @ (M @ q_u0)  # Φ is M-orthonormal: q = Φᵀ M u
+    qd0 = phi.T @ (M @ q_v0)
+
+    if sliders.velocity_dependent:
+        _check_friction_rate(sliders, P, w2, cd, diag, float(dt), gz)
+    why_not = _exact_unsupported(w2, cd, diag, sliders.dof) or (
+        "nonlinear hinges or velocity-dependent friction need equilibrium iterations"
+        if nonlinear else "")
+    if method == "exact" and why_not:
+        raise InputError("method", method, f'"newmark" or "auto" here: {why_not}')
+    use_exact = method != "newmark" and not why_not
+    kern = get_kernel(backend, "exact" if use_exact else "newmark")
+    used = "numba" if kern.__name__.endswith("_numba") else "python"
+    mass = chk.writable(sliders.mass)
+    mus = chk.writable(sliders.mu_static)
+    mud = chk.writable(sliders.mu_dynamic)
+    P = chk.writable(P)
+    w2c = chk.writable(w2)
+    ag = chk.writable(ag)
+    pat = chk.writable(pat)
+
+    nh = hinges.count if hinges.nonlinear else 0
+    Q = hinges.operator(phi)[:nh]
+    hst = hinges.initial_state()[:nh]
+    # writable: a read-only array (a compiled model's) is another numba specialisation
+    h_k, h_law, h_par, h_th0 = (chk.writable(a[:nh]) for a in
+                                (hinges.k, hinges.law, hinges.par, hinges.theta0))
+    rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
+    buf = _Buffers(chunk + 1, nb, m, nh)
+    keep = _Kept(n_keep, nb, m, track_energy, nh)
+    ev_time = np.empty(max_events + 1)
+    ev_slider = np.empty(max_events + 1, dtype=np.int64)
+    ev_kind = np.empty(max_events + 1, dtype=np.int64)
+    w_state = np.zeros(m)
+    wd_state = np.zeros(m)
+    stuck_state = np.ones(m, dtype=np.bool_)
+    sig_state = np.ones(m)
+    e_state = np.zeros(4)
+    status, n_ev, n_sub, n_cfg = 0, 0, 0, 0
+    if use_exact:
+        a1 = _stiffness_proportional(w2, cd)
+        cache_size = int(np.clip(2.0e8 / (8.0 * (2 * nb * nb + nb * pat.shape[0] + 6 * nb + m)),
+                                 4, 64))
+    qs, qds = q0, qd0
+    start = 0
+    with one_blas_thread():
+        while start < n_steps:
+            stop = min(start + chunk, n_steps)
+            rows = slice(start, stop + 1)
+            k = stop - start + 1
+            ser = np.ascontiguousarray(series[rows])
+            pext = np.ascontiguousarray(ser @ pat)
+            N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
+            ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
+            left = max(int(max_events) - n_ev, 0)
+            outs = buf.views(k)
+            if use_exact:
+                st, ne, ns, nc = kern.run_kernel_exact(
+                    w2c, cd, a1, not bool(np.any(on_structure)), P, mass, mus, mud, float(dt),
+                    ag[rows], pext, pat, ser, N, qs, qds,
+                    start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                    start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
+                    *outs[:8], *ev,
+                )
+                n_cfg += int(nc)
+            else:
+                st, ne, ns = kern.run_kernel(
+                    w2c, cd, Cq, diag, P, mass, mus, mud, rate, Q, h_th0, h_k, h_law, h_par, hst,
+                    float(dt), ag[rows], pext, N, qs, qds,
+                    start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
+                    start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
+                )
+            n_ev += int(ne)
+            n_sub += int(ns)
+            status = int(st)
+            t_chunk = np.arange(start, stop + 1) * dt
+            if on_chunk is not None:
+                on_chunk(Chunk(t_chunk, outs[0], outs[1], outs[2], outs[5], outs[6],
+                               hinge_moment=outs[8], slider_u=outs[3], slider_v=outs[4], P=P))
+            keep.take(start, stop, n_steps, save_every, outs, N)
+            qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
+            if status != 0:
+                break
+            if progress is not None:
+                progress(stop - start)
+            start = stop
+
+    status_text = _STATUS.get(int(status), f"status {status}")
+    if status != 0:
+        msg = f"stick-slip integration stopped: {status_text}"
+        if throw:
+            raise SolverError(msg)
+        _LOG.warning(msg)
+    n_keep_ev = min(int(n_ev), max_events)
+    events = [
+        Event(float(ev_time[k]), int(ev_slider[k]), EVENT_KINDS[int(ev_kind[k])])
+        for k in range(n_keep_ev)
+    ]
+    kq, kqd, kqdd, kw, kwd, klam, kst, ken, khm, kN, kidx = keep.result()
+    energy = {}
+    if track_energy:
+        names = ("input", "kinetic", "strain", "damping", "friction")
+        energy = {nm: ken[:, c].copy() for c, nm in enumerate(names)}
+        if nh:
+            energy["strain"], energy["hysteresis"] = energy_split(
+                energy["strain"], kq, w2, kq @ Q.T + h_th0, khm, h_k, h_th0,
+                hinges.initial_moment()[:nh])
+    return TimeHistory(
+        t=kidx * dt,
+        q=kq,
+        qd=kqd,
+        qdd=kqdd,
+        phi=phi,
+        slider_u=kw,
+        slider_v=kwd,
+        sliding=kw - kq @ P.T,
+        friction=klam,
+        normal=kN,
+        stuck=kst,
+        slider_dof=sliders.dof.copy(),
+        events=events,
+        energy=energy,
+        status=status_text,
+        backend=used,
+        n_substeps=int(n_sub),
+        method="exact" if use_exact else "newmark",
+        n_configurations=int(n_cfg),
+        basis=bas.describe(),
+        sample_index=kidx,
+        hinge_moment=khm,
+        hinge_operator=Q,
+        hinge_rotation0=h_th0,
+    )

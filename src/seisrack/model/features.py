@@ -1,0 +1,70 @@
+"""What is built for which rack dimension: one table, and the refusals that name the feature.
+
+A 2D (plane) rack and a 3D (space) rack are the same kind of thing and take the same path; a
+capability that exists for one dimension only is listed here, and asking for it on the other
+raises an :class:`~seisrack.errors.InputError` that names the feature and the field that asked
+for it ("nonlinear connections are not built for 3D racks yet"), never a type check.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from seisrack.errors import InputError
+
+#: feature -> the rack dimensions it is built for
+FEATURES: dict[str, tuple[int, ...]] = {
+    "nonlinear connections ([hysteresis])": (2,),
+    "velocity-dependent friction (friction_rate)": (2,),
+    "exact modal propagators (method exact)": (2,),
+    "a cross-aisle ground motion component": (3,),
+    "an incidence angle of the horizontal components": (3,),
+}
+
+
+def built_for(feature: str, ndm: int) -> bool:
+    """Whether ``feature`` (a key of :data:`FEATURES`) is built for a ``ndm``-D rack."""
+    return ndm in FEATURES[feature]
+
+
+def require(feature: str, ndm: int, field: str, value: Any, *, source: str | None = None
+            ) -> None:
+    """InputError on ``field`` unless ``feature`` is built for a ``ndm``-D rack."""
+    if built_for(feature, ndm):
+        return
+    dims = " and ".join(f"{d}D" for d in FEATURES[feature])
+    raise InputError(field, value, f"a {dims} rack: {feature} is not built for {ndm}D racks"
+                     + (" yet" if ndm == 3 else ""), source=source)
+
+
+def check_features(spec: Any) -> None:
+    """Refuse, before any work, what the rack file asks for and its dimension does not have,
+    and check that a 3D rack's sections carry what a space frame needs."""
+    ndm = spec.ndm
+    src = spec.source
+    if spec.hysteresis.nonlinear:
+        require("nonlinear connections ([hysteresis])", ndm, "hysteresis", "nonlinear law",
+                source=src)
+    rates = [i for i, p in enumerate(spec.pallets) if p.friction_rate]
+    if rates:
+        require("velocity-dependent friction (friction_rate)", ndm,
+                f"pallets[{rates[0]}].friction_rate", spec.pallets[rates[0]].friction_rate,
+                source=src)
+    if ndm == 3:
+        _check_sections_3d(spec)
+
+
+def _check_sections_3d(spec: Any) -> None:
+    geo = spec.geometry
+    for name in sorted(set(geo.beam_sections) | set(geo.upright_sections)):
+        s = spec.sections[name]
+        for key, value in (("I", s.I), ("Iy", s.Iy), ("J", s.J)):
+            if value is None or math.isnan(value):
+                what = {"I": "I (or Iz): bending in the down-aisle plane",
+                        "Iy": "Iy: bending in the other principal plane (cross-aisle for an "
+                              "upright, horizontal for a beam)",
+                        "J": "J: St Venant torsion constant"}[key]
+                raise InputError(f"sections.{name}.{key}", None, f"a value > 0 [m⁴] ({what})",
+                                 source=spec.source, hint="A 3D rack needs I (or Iz), Iy and J "
+                                 "for every beam and upright section")
