@@ -10,9 +10,9 @@ References (independent of the engine):
   (``tests/test_engine_planar._block_reference``) under two sinusoidal components: measured
   8.2e-5, 2.2e-5, 5.8e-6 m at dt 5, 2.5, 1.25 ms, order 1.98 (the planar engine: 4.2e-4,
   2.1e-4, 5.1e-5);
-- the planar engine (``simulate_planar``, full basis, exact event location) on a flexible
-  four-DOF frame with two pallets sliding in the plane: 2.3e-5 m apart at dt 2 ms (0.07 % of
-  the peak), the same 37 events.
+- the planar engine (``simulate`` with PlanarSliders, full basis, exact event location) on a
+  flexible four-DOF frame with two pallets sliding in the plane: 2.3e-5 m apart at dt 2 ms
+  (0.07 % of the peak), the same 37 events.
 The energy balance input = kinetic + strain + damping + friction closes to 1e-9 of the input
 (an identity of the trapezoidal rule in impulse form, docs/theory/local_engine.md §3).
 """
@@ -25,14 +25,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from seisrack.dynamics import PlanarSliders
 from seisrack.dynamics.local import LocalSliders
 from seisrack.dynamics.local.engine import memory_estimate, simulate_local
-from seisrack.dynamics.planar import PlanarSliders, simulate_planar
 from seisrack.dynamics.reference import simulate_reference
 from seisrack.errors import InputError
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_engine_planar import MUD, MUS, _block_reference, _frame, ax_fn, az_fn  # noqa: E402
+from test_engine_planar import (  # noqa: E402
+    MUD,
+    MUS,
+    _block_reference,
+    _frame,
+    _run_planar,
+    ax_fn,
+    az_fn,
+)
 
 M2 = np.diag([800.0, 800.0])
 K2 = np.array([[3.5e6, -1.5e6], [-1.5e6, 1.5e6]])
@@ -99,7 +107,7 @@ def test_flexible_frame_in_the_plane_equals_the_planar_engine():
     dt = 0.002
     t = np.arange(0, 6 + dt / 2, dt)
     gx, gz = 0.5 * ax_fn(t), 0.5 * az_fn(t)
-    hp = simulate_planar(M, C, K, PlanarSliders([0, 1], [2, 3], [400.0, 500.0], [0.3, 0.25],
+    hp = _run_planar(M, C, K, PlanarSliders([0, 1], [2, 3], [400.0, 500.0], [0.3, 0.25],
                                                 [0.22, 0.2]), dt=dt, ground_x=gx,
                          influence_x=[1, 1, 0, 0], ground_z=gz, influence_z=[0, 0, 1, 1],
                          basis="full")

@@ -14,8 +14,8 @@ from collections.abc import Callable
 import numpy as np
 
 from seisrack.dynamics import _inputs as chk
+from seisrack.dynamics._blas import blas_controller
 from seisrack.dynamics._setup import DEFAULT_MAX_MEMORY
-from seisrack.dynamics.engine import _blas_controller
 from seisrack.dynamics.kernels import numba_available
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
@@ -232,7 +232,7 @@ def simulate_local(
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     stats = np.zeros(6, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
-    limiter = _blas_controller().limit(limits=1, user_api="blas")
+    limiter = blas_controller().limit(limits=1, user_api="blas")
     try:
         while start < n_steps:
             stop = min(start + chunk, n_steps)

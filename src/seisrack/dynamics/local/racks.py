@@ -1,5 +1,5 @@
-"""The local engine's inputs from a compiled rack (2D :class:`~seisrack.model.frame_model.
-FrameModel` or 3D :class:`~seisrack.model.frame_model3d.FrameModel3D`): the slice of every
+"""The local engine's inputs from a compiled rack (a 2D or 3D :class:`~seisrack.model.
+frame_model.FrameModel`): the slice of every
 DOF (the upright line and the bay to its right, from the node's x), the pallets as
 :class:`LocalSliders`, and the global loads whose responses carry the far field (a uniform
 load on every beam level, per side and direction)."""
@@ -55,11 +55,7 @@ def rack_slices(model) -> np.ndarray:  # noqa: ANN001
 def rack_sliders(model) -> LocalSliders:  # noqa: ANN001
     """The pallets of ``model``: 3D, resting on the front and rear beam nodes, sliding in x
     and z; 2D, on one DOF, sliding along x."""
-    if getattr(model, "is_3d", False):
-        sup = np.stack([model.pallet_dof_x, model.pallet_dof_z], axis=2)
-    else:
-        sup = np.asarray(model.pallet_dof)[:, None, None]
-    return LocalSliders(sup, model.pallet_mass, model.pallet_mu_static,
+    return LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass, model.pallet_mu_static,
                         model.pallet_mu_dynamic)
 
 
@@ -71,8 +67,8 @@ def rack_global_loads(model, mass: sp.spmatrix) -> np.ndarray:  # noqa: ANN001
     ys = np.asarray(model.level_y)
     n = model.K_sparse.shape[0]
     cols = []
-    if getattr(model, "is_3d", False):
-        zs = (0.0, float(model.depth))
+    if model.ndm == 3:
+        zs = tuple(float(z) for z in np.asarray(model.frame_z))
         comps = (0, 2)
     else:
         zs = (None,)
@@ -103,10 +99,7 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
     n = model.K_sparse.shape[0]
     M = model.M_sparse
     extra = sl.attached_mass(n)
-    if getattr(model, "is_3d", False):
-        infl = [model.r_x, model.r_z] + ([model.r_y] if vertical else [])
-    else:
-        infl = [model.r_x] + ([model.r_y] if vertical else [])
+    infl = list(model.influence) + ([model.r_y] if vertical else [])
     loads = np.column_stack([M @ r for r in infl])
     pats = sl.patterns(n)
     b = local_basis(M, model.C_sparse, model.K_sparse, rack_slices(model), loads, pats,
@@ -127,8 +120,7 @@ def simulate_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None, 
     other keywords as ``simulate_local``."""
     from seisrack.dynamics.local.engine import simulate_local
 
-    is3d = getattr(model, "is_3d", False)
-    infl = np.array([model.r_x, model.r_z]) if is3d else np.array([model.r_x])
+    infl = np.array(model.influence)
     if basis is None:
         basis = rack_basis(model, vertical=vertical_accel is not None)
     return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse, rack_sliders(model),
@@ -157,10 +149,10 @@ def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa:
     displacements and falls over every step (``on_chunk``); keeps two samples only."""
     from seisrack.analysis.pallet_contacts import ContactTracker
 
-    is3d = getattr(model, "is_3d", False)
+    is3d = model.ndm == 3
     if basis is None:
         basis = rack_basis(model, vertical=vertical_accel is not None)
-    levels = [model.level_dofs_x, model.level_dofs_z] if is3d else [model.level_dofs]
+    levels = list(model.level_dofs)
     ops = [np.array([basis.rows(np.asarray(d)).mean(axis=0) for d in lv]) for lv in levels]
     m = model.n_pallets
     peak = np.zeros((m, 3))
