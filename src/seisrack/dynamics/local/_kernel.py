@@ -29,6 +29,8 @@ STATUS_NEWTON = 2
 STATUS_NONFINITE = 3
 STATUS_NOT_PD = 4
 _NEWTON_MAX = 40
+#: Newton iterations after which a stalled step freezes its pallets' slip onsets too
+_NEWTON_FREEZE = 15
 #: Newton stops when its step is below this fraction of the velocities (1e-11 cost a third
 #: more iterations than 1e-9 on the warehouse rack for no change of the results)
 _NEWTON_TOL = 1e-9
@@ -452,6 +454,15 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 for p in range(m):
                     dj = abs(outs_n[p, 0] - outs[p, 0]) + abs(outs_n[p, 1] - outs[p, 1])
                     if dj > 1e-4 * (abs(outs[p, 0]) + abs(outs[p, 1]) + mass[p] * h):
+                        mus_k[p] = 1e300
+                        stats[5] += 1
+                    elif _it >= _NEWTON_FREEZE and outs[p, 17] > 0.0 and mus_k[p] < 1e300:
+                        # still stalled: a pallet with an event inside the step keeps (or,
+                        # after a stop, takes) the contact for the rest of the step: a slip
+                        # onset whose impulse falls with y as fast as the support's
+                        # compliance allows (mu_d < mu_s: H is singular along it, the onset
+                        # time undetermined; 3D paper rack under El Centro, four pallets at
+                        # t = 2.055 s), or a stop whose restart toggles between iterations
                         mus_k[p] = 1e300
                         stats[5] += 1
                 _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
