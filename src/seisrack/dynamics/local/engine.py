@@ -230,7 +230,7 @@ def simulate_local(
             np.empty((chunk + 1, m), dtype=np.bool_), np.empty((chunk + 1, 5)))
     keep_idx = _keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
-    stats = np.zeros(6, dtype=np.int64)
+    stats = np.zeros(7, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
     limiter = blas_controller().limit(limits=1, user_api="blas")
     try:
@@ -286,7 +286,8 @@ def simulate_local(
         sample_index=keep_idx, energy=energy_d, local_basis=basis, status=status_text,
         backend=used, basis=basis.describe(),
         work=dict(zip(("steps", "newton_iterations", "factorisations", "local_solves",
-                       "line_search_evaluations", "frozen_contacts"), (int(x) for x in stats),
+                       "line_search_evaluations", "frozen_contacts", "loose_steps"),
+                      (int(x) for x in stats),
                       strict=True)))
 
 
