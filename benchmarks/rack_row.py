@@ -149,9 +149,10 @@ def main() -> None:
             path = _variant(t, bays, levels)
             label = f"3D {bays} x {levels}"
             rows.append((label, "local", _spawn("local", path, seconds)))
+            print(rows[-1], flush=True)
             if with_planar:
                 rows.append((label, "planar (today)", _spawn("planar", path, seconds)))
-            print(rows[-1], flush=True)
+                print(rows[-1], flush=True)
         rows.append(("2D warehouse example", "local",
                      _spawn("local", ROOT / "examples/warehouse_rack.toml", seconds)))
     load1 = os.getloadavg()
