@@ -14,6 +14,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from seisrack.analysis.response import ACCEL_FILTER_ORDER
 from seisrack.dynamics.engine import Chunk
@@ -76,18 +77,31 @@ class DesignOps:
         return tuple(self.ops)
 
 
+def project(op, phi) -> np.ndarray:  # noqa: ANN001
+    """(r, k) dense ``phiᵀ op`` of an operator ``op`` (n, k), dense or sparse, onto a basis
+    ``phi`` (n, r), dense or sparse (the local engine's basis), neither densified first."""
+    x = (op.T @ phi).T
+    return x.toarray() if sp.issparse(x) else np.asarray(x)
+
+
+def _level_mean(phi, dofs) -> np.ndarray:  # noqa: ANN001
+    """(r,) mean of the rows ``dofs`` of ``phi`` (dense or sparse)."""
+    return np.asarray(phi[np.asarray(dofs)].mean(axis=0)).ravel()
+
+
 def rack_operators(model, phi: np.ndarray, design: bool = True) -> RackOperators:  # noqa: ANN001
-    """Project the level-averaging and force-recovery operators of ``model`` onto ``phi``."""
+    """Project the level-averaging and force-recovery operators of ``model`` onto ``phi``
+    (dense, or sparse for the local engine's basis)."""
     from seisrack.fe.recovery import rack_operators as element_operators
     from seisrack.fe.recovery import recovery_operators
 
     # one pass over the members for both operator sets
     ops, des = element_operators(model) if design else (recovery_operators(model), None)
-    level = tuple(np.column_stack([phi[np.asarray(d)].mean(axis=0) for d in dofs])
+    level = tuple(np.column_stack([_level_mean(phi, d) for d in dofs])
                   for dofs in model.level_dofs)
 
     def proj(op) -> np.ndarray:  # noqa: ANN001
-        return np.asarray((op.T @ phi).T)  # (r, k), sparse op never densified
+        return project(op, phi)  # (r, k), sparse op never densified
 
     return RackOperators(
         level=level, shear=proj(ops.base_shear),
@@ -119,7 +133,7 @@ def design_ops(model, phi: np.ndarray, rec, level: tuple, d) -> DesignOps:  # no
     drift_map = diff / height[None, :]
 
     def proj(op) -> np.ndarray:  # noqa: ANN001
-        return np.asarray((op.T @ phi).T)
+        return project(op, phi)
 
     # gravity alone, K u = -g M r_y (M holds the members and the pallets' vertical masses);
     # a sparse solve of the full model, once per model

@@ -66,6 +66,15 @@ def rack_sliders(model: FrameModel, mu: float | None = None) -> Sliders | Planar
 _MODEL_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
+def model_cache(model: FrameModel) -> dict:
+    """The prepared runs of ``model`` by key (weakly held: dropped with the model; a fresh
+    dict for an object that cannot be weakly referenced, so nothing is kept)."""
+    try:
+        return _MODEL_CACHE.setdefault(model, {})
+    except TypeError:
+        return {}
+
+
 def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: bool = False,
                 design: bool = True) -> PreparedRun:
     """The :class:`PreparedRun` of ``model`` (cached per model for a named basis: a compiled
@@ -73,12 +82,7 @@ def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: boo
     given = isinstance(basis, Basis)
     if not given and basis not in ("auto", "full", "reduced"):
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
-    cache: dict = {}
-    if not given:
-        try:
-            cache = _MODEL_CACHE.setdefault(model, {})
-        except TypeError:  # not weakly referenceable (a stand-in object): nothing is kept
-            pass
+    cache = {} if given else model_cache(model)
     key = (None if given else basis, bool(vertical), bool(design))
     hit = cache.get(key)
     if hit is None:

@@ -93,6 +93,7 @@ def run_rack(
     max_memory: float | None = None,
     accel_filter_hz: float = ACCEL_FILTER_HZ,
     prepared: PreparedRun | None = None,
+    engine: str = "default",
 ) -> RackResponse:
     """Time history of ``model`` (2D or 3D) under the ground motion ``motion``.
 
@@ -121,6 +122,10 @@ def run_rack(
     prepared: :func:`~seisrack.analysis.prepare.prepare_run` of this model's structure, made
         once by a caller that runs it many times (a study); default: prepared (and cached)
         here.
+    engine: "default" (the engines above) or "local" (opt-in, issue 22: a local basis and
+        each pallet's events resolved inside the step, cost linear in the rack's length;
+        linear connections and Coulomb friction only, ``method`` and ``basis`` left "auto";
+        :mod:`seisrack.analysis.local_run`).
     """
     if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
             and accel_filter_hz > 0):
@@ -128,6 +133,9 @@ def run_rack(
     if not (isinstance(free_vibration, int | float) and math.isfinite(free_vibration)
             and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
+    from seisrack.analysis.local_run import check_engine
+
+    check_engine(engine, model, method=method, basis=basis)
     mot = ground_motion(model, motion, vertical)
     if method == "exact":
         require("exact modal propagators (method exact)", model.ndm, "method", method)
@@ -135,6 +143,11 @@ def run_rack(
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))
     ag, av = mot.on_grid(k, model.n_dir)
+    if engine == "local":
+        return _run_local(model, mot, ag, av, h, prepared=prepared, backend=backend,
+                          rigid_companion=rigid_companion, progress=progress, throw=throw,
+                          save_every=save_every, max_memory=max_memory,
+                          accel_filter_hz=accel_filter_hz)
     if prepared is None:
         prepared = prepare_run(model, basis=basis, vertical=av is not None)
     elif prepared.n_dof != model.n_dof:
@@ -203,6 +216,49 @@ def run_rack(
                    beam_acceleration_filtered=None if acc_filt is None
                    else squeeze(acc_filt[idx]),
                    hinges=None if hinges is None else hinge_response(model, hist, hpk))
+
+
+def _run_local(model: FrameModel, mot: GroundMotion, ag: np.ndarray, av: np.ndarray | None,
+               h: float, *, prepared: PreparedRun | None, backend: str, rigid_companion: bool,
+               progress: Callable[[int], None] | None, throw: bool, save_every: int | None,
+               max_memory: float | None, accel_filter_hz: float) -> RackResponse:
+    """:func:`run_rack` on the local engine (:mod:`seisrack.analysis.local_run`)."""
+    from seisrack.analysis.local_run import prepare_local, simulate_rack_local
+    from seisrack.dynamics.local.basis import LocalBasis
+
+    if prepared is None or not isinstance(prepared.basis, LocalBasis):
+        prepared = prepare_local(model, vertical=av is not None)
+    ops = prepared.ops
+    # the engine's accelerations are already central differences of the velocities
+    tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, keep_accel=True,
+                          design=True)
+    contacts = ContactTracker(model.layout, model.n_pallets)
+
+    def on_chunk(chunk) -> None:  # noqa: ANN001
+        tracker(chunk)
+        contacts(chunk)
+
+    hist = simulate_rack_local(model, prepared, ag, av, h, on_chunk=on_chunk,
+                               progress=progress, save_every=save_every,
+                               max_memory=max_memory, throw=throw, backend=backend)
+    peaks = tracker.result()
+    acc_full = tracker.level_acceleration()
+    acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
+    peaks["beam_acceleration_filtered"] = (
+        None if acc_filt is None else np.abs(acc_filt).max(axis=0))
+    rigid_peak = None
+    if rigid_companion and model.n_pallets:
+        rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False)
+        simulate_rack_local(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=rig,
+                            save_every=None, max_memory=max_memory, throw=throw,
+                            backend=backend)
+        rigid_peak = rig.result()["beam_acceleration_magnitude"]
+    resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
+    idx = hist.sample_index
+    squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
+    return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
+                   beam_acceleration_filtered=None if acc_filt is None
+                   else squeeze(acc_filt[idx]), hinges=None)
 
 
 def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:

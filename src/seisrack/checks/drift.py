@@ -86,6 +86,8 @@ def drift_sensitivity_check(model: Any, response: Any, factors: CheckFactors | N
     """θ per storey and horizontal direction from ``response`` (a RackResponse of ``model``);
     JSON-ready dict. The storey shear is projected onto the run's basis (never an
     (n_t, n_dof) history)."""
+    from seisrack.analysis.peaks import project
+
     f = factors or CheckFactors()
     level_y = np.asarray(model.level_y, dtype=float)
     h = np.diff(np.concatenate([[0.0], level_y]))
@@ -99,7 +101,7 @@ def drift_sensitivity_check(model: Any, response: Any, factors: CheckFactors | N
         rel = np.diff(np.concatenate([np.zeros((disp.shape[0], 1)), disp], axis=1), axis=1)
         d_r = np.max(np.abs(rel), axis=0)
         op = storey_shear_operator(model, d)
-        V = np.max(np.abs(hist.q @ np.asarray((op.T @ hist.phi).T)), axis=0)
+        V = np.max(np.abs(hist.q @ project(op, hist.phi)), axis=0)
         for s in range(h.size):
             theta = sensitivity_theta(P[s], d_r[s], V[s], h[s])
             text, ok = theta_verdict(theta, f)

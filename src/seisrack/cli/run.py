@@ -65,6 +65,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("--basis", choices=("auto", "full", "reduced"), default="auto",
                    help="structure basis: every mode (full), a load-dependent Ritz basis "
                         "(reduced), or auto (full up to 50 DOFs; default)")
+    p.add_argument("--engine", choices=("default", "local"), default="default",
+                   help="stick-slip engine: default, or local (opt-in: a local basis and "
+                        "per-pallet events, cost linear in the rack's length; linear "
+                        "connections and Coulomb friction, --method and --basis left auto)")
     p.add_argument("--save-every", type=int, default=1, metavar="K",
                    help="keep every K-th analysis step in the histories (peaks always use "
                         "every step; default 1)")
@@ -154,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from seisrack.analysis import analysis_grid, run_rack
+    from seisrack.analysis.local_run import check_engine
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.model import compile_rack, load_rack, with_friction
@@ -167,6 +172,8 @@ def run(args: argparse.Namespace) -> int:
         model = compile_rack(spec)
     if args.method == "exact" and model.n_dir > 1:
         require("exact modal propagators (method exact)", model.ndm, "--method", args.method)
+    engine = getattr(args, "engine", "default")
+    check_engine(engine, model, method=args.method, basis=args.basis, cli=True)
     motion, scaling = ground_motion_from_args(args, model)
     check_run_size(args, model, motion)  # before the run allocates anything
     try:
@@ -182,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         resp = run_rack(model, motion, dt=motion.dt / k, free_vibration=args.free_vibration,
                         method=args.method, basis=args.basis, save_every=args.save_every,
-                        rigid_companion=args.rigid_check,
+                        rigid_companion=args.rigid_check, engine=engine,
                         progress=None if bar is None else bar.update,
                         **({} if args.accel_filter is None
                            else {"accel_filter_hz": args.accel_filter}))
@@ -193,6 +200,8 @@ def run(args: argparse.Namespace) -> int:
     _result_warnings(resp, model)
     summary = {"rack": args.rack, "title": spec.title, **resp.summary(),
                "integration": resp.history.method, "basis": resp.history.basis}
+    if engine != "default":
+        summary["engine"] = engine
     if resp.history.work:
         summary["work"] = resp.history.work
     if scaling is not None:

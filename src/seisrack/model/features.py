@@ -23,6 +23,28 @@ FEATURES: dict[str, tuple[int, ...]] = {
 }
 
 
+#: engine of the time history -> what it does not do (yet); the default engine does everything
+#: :data:`FEATURES` lists for the rack's dimension
+ENGINE_LACKS: dict[str, tuple[str, ...]] = {
+    "local": (
+        "nonlinear connections ([hysteresis])",
+        "velocity-dependent friction (friction_rate)",
+        "a choice of time integration (method)",
+        "a choice of structure basis (basis)",
+    ),
+}
+
+
+def require_engine(feature: str, engine: str, field: str, value: Any, *,
+                   source: str | None = None) -> None:
+    """InputError on ``field`` when ``engine`` lacks ``feature`` (:data:`ENGINE_LACKS`)."""
+    if feature not in ENGINE_LACKS.get(engine, ()):
+        return
+    raise InputError(field, value, f"the default engine: {feature} is not built in the "
+                     f"{engine} engine yet", source=source,
+                     hint=f"Run without engine {engine!r} (the default engine has it)")
+
+
 def built_for(feature: str, ndm: int) -> bool:
     """Whether ``feature`` (a key of :data:`FEATURES`) is built for a ``ndm``-D rack."""
     return ndm in FEATURES[feature]

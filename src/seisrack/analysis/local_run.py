@@ -1,0 +1,129 @@
+"""The local engine (issue 22, ``docs/theory/local_engine.md``) behind the one rack path:
+``run_rack(model, motion, engine="local")``.
+
+What is prepared once per model (the local basis with its measured error, the rack operators
+projected onto it), and one run of the engine returned as the
+:class:`~seisrack.dynamics.results.TimeHistory` the rest of the path reads (peaks, falls,
+writer, report). The engine's chunks are handed on as the usual
+:class:`~seisrack.dynamics._chunk.Chunk`; the reported accelerations are the central
+differences of the velocities, ``(v[n+1] - v[n-1]) / 2h`` (the trapezoidal rule's own end
+accelerations carry the period-2h residue of the stiff directions, see
+:func:`seisrack.analysis.rack.smoothed_acceleration`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from seisrack.analysis.peaks import rack_operators
+from seisrack.analysis.prepare import PreparedRun, model_cache
+from seisrack.dynamics._chunk import Chunk
+from seisrack.dynamics.results import TimeHistory
+from seisrack.errors import InputError
+from seisrack.model.features import require_engine
+from seisrack.model.frame_model import FrameModel
+
+#: the engines of :func:`seisrack.analysis.run_rack`
+ENGINES = ("default", "local")
+
+
+def check_engine(engine: str, model: FrameModel, *, method: str = "auto",
+                 basis: object = "auto", cli: bool = False) -> None:
+    """Refuse, by name, what ``engine`` does not do for ``model`` (``cli``: name the
+    command's options)."""
+    opt = "--" if cli else ""
+    if engine not in ENGINES:
+        raise InputError(f"{opt}engine", engine, " or ".join(f'"{e}"' for e in ENGINES))
+    if engine == "default":
+        return
+    if model.nonlinear_hinges:
+        require_engine("nonlinear connections ([hysteresis])", engine, "hysteresis",
+                       "a nonlinear law")
+    rates = np.flatnonzero(np.asarray(model.pallet_friction_rate) != 0)
+    if rates.size:
+        j = int(rates[0])
+        require_engine("velocity-dependent friction (friction_rate)", engine,
+                       f"friction_rate of pallet {j + 1}", float(model.pallet_friction_rate[j]))
+    if method != "auto":
+        require_engine("a choice of time integration (method)", engine, f"{opt}method",
+                       method)
+    if not (isinstance(basis, str) and basis == "auto"):
+        require_engine("a choice of structure basis (basis)", engine, f"{opt}basis",
+                       basis if isinstance(basis, str) else type(basis).__name__)
+
+
+def prepare_local(model: FrameModel, *, vertical: bool = False, design: bool = True
+                  ) -> PreparedRun:
+    """The local basis of ``model`` (its static energy error measured against the full
+    model) and the rack operators projected onto it (cached per model)."""
+    from seisrack.dynamics.local.racks import rack_basis
+
+    cache = model_cache(model)
+    key = ("local", bool(vertical), bool(design))
+    hit = cache.get(key)
+    if hit is None:
+        b = rack_basis(model, vertical=vertical)
+        ops = rack_operators(model, b.matrix().tocsr(), design=design)
+        hit = cache[key] = PreparedRun(basis=b, ops=ops, hinges=None,
+                                       vertical=vertical, n_dof=model.n_dof)
+    return hit
+
+
+def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
+                        av: np.ndarray | None, h: float, *, mu: float | None = None,
+                        on_chunk: Callable[[Chunk], None] | None = None,
+                        progress: Callable[[int], None] | None = None,
+                        save_every: int | None = 1, max_memory: float | None = None,
+                        throw: bool = True, backend: str = "auto") -> TimeHistory:
+    """One run of the local engine on ``model``: ``ag`` (n_t, n_dir) [m/s²] the horizontal
+    ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
+    ``mu`` replaces every friction coefficient (the rigid companion)."""
+    from seisrack.dynamics.local import LocalSliders
+    from seisrack.dynamics.local.engine import _keep_index, simulate_local
+
+    b = prepared.basis
+    nd = model.n_dir
+    line = nd == 1
+    sliders = LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass,
+                           model.pallet_mu_static if mu is None else mu,
+                           model.pallet_mu_dynamic if mu is None else mu)
+    n_steps = ag.shape[0] - 1
+    keep = _keep_index(n_steps, save_every)
+    qdd = np.zeros((keep.size, b.size))
+    state: dict = {"v_prev": None}
+    sq = (lambda a: a[..., 0]) if line else (lambda a: a)  # noqa: E731
+
+    def chunk_cb(ch) -> None:  # noqa: ANN001
+        v = ch.v
+        k = v.shape[0]
+        a = np.empty_like(v)
+        if k >= 3:
+            a[1:-1] = (v[2:] - v[:-2]) / (2.0 * h)
+        vp = state["v_prev"]
+        a[0] = (v[1] - vp) / (2.0 * h) if vp is not None else (v[1] - v[0]) / h
+        a[-1] = (v[-1] - v[-2]) / h
+        state["v_prev"] = v[-2].copy()
+        k0 = int(round(ch.t[0] / h))
+        sel = (keep >= k0) & (keep < k0 + k)
+        qdd[sel] = a[keep[sel] - k0]
+        if on_chunk is not None:
+            on_chunk(Chunk(ch.t, ch.q, v, a, sq(ch.friction), ch.stuck,
+                           sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
+
+    hist = simulate_local(
+        model.M_sparse, model.C_sparse, model.K_sparse, sliders, dt=h, ground=ag,
+        influence=np.array(model.influence), vertical_accel=av,
+        vertical_influence=None if av is None else model.r_y, g=model.g, basis=b,
+        check="none", save_every=save_every, keep_coordinates=True, on_chunk=chunk_cb,
+        progress=progress, max_memory=max_memory, throw=throw, backend=backend)
+    n_keep = hist.sample_index.size
+    d = np.asarray(model.pallet_dofs)
+    return TimeHistory(
+        t=hist.t, q=hist.q, qd=hist.v, qdd=qdd[:n_keep], phi=b.matrix().tocsr(),
+        slider_u=None, slider_v=None, sliding=sq(hist.sliding), friction=sq(hist.friction),
+        normal=hist.normal, stuck=hist.stuck, slider_dof=d[:, 0, 0] if line else d[:, :, 0],
+        events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,
+        method="local", basis=hist.basis, sample_index=hist.sample_index,
+        sliding_v=sq(hist.velocity), work=hist.work)

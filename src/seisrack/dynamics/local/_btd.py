@@ -1,0 +1,143 @@
+"""Block-tridiagonal algebra of the local engine (source shared by the numba and the
+pure-Python backends; theory: ``docs/theory/local_engine.md`` §2–§3).
+
+A symmetric block-tridiagonal matrix is held as ``Ad`` (n_s, bmax, bmax), its diagonal blocks,
+and ``Ao`` (n_s − 1, bmax, bmax), the blocks (s, s + 1); block s is ``sizes[s]`` square,
+zero-padded. Its Cholesky factor ``L`` is held as ``Ld`` (lower triangles of the diagonal
+blocks) and ``X`` with ``X[s] = L_ss⁻¹ A_(s, s+1)`` (= ``L_(s+1, s)ᵀ``), so that
+``S_(s+1) = A_(s+1, s+1) − X[s]ᵀ X[s]`` and ``L_(s+1, s+1) = chol(S_(s+1))``: the cost is
+``Σ_s (7/3) b_s³``, linear in the number of slices.
+"""
+
+# ruff: noqa: N803, N806  (matrix names follow the equations)
+
+
+try:  # names injected by the loader when executed after ``_blas.py``
+    _potrf_corner  # type: ignore[used-before-def]  # noqa: B018
+except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics.local._blas import _potrf_corner, _syrk_corner, _trsm_corner
+
+    def _JIT(f):  # type: ignore[no-redef]
+        return f
+
+
+@_JIT
+def _trsv_lower(L, b, x):
+    """x[:b] = L⁻¹ x[:b] (L lower triangular, rows contiguous)."""
+    for i in range(b):
+        acc = x[i]
+        for k in range(i):
+            acc -= L[i, k] * x[k]
+        x[i] = acc / L[i, i]
+
+
+@_JIT
+def _trsv_upper(L, b, x):
+    """x[:b] = L⁻ᵀ x[:b]."""
+    for i in range(b - 1, -1, -1):
+        xi = x[i] / L[i, i]
+        x[i] = xi
+        for k in range(i):
+            x[k] -= L[i, k] * xi
+
+
+@_JIT
+def _btd_factor(Hd, Ho, sizes, Ld, X):
+    """Cholesky factor of the block-tridiagonal (Hd, Ho) into (Ld, X) (LAPACK / BLAS on the
+    blocks, ``_blas.py``). False if the matrix is not positive definite."""
+    ns = sizes.shape[0]
+    for s in range(ns):
+        b = sizes[s]
+        L = Ld[s]
+        for i in range(b):
+            for k in range(i + 1):
+                L[i, k] = Hd[s, i, k]
+        if s > 0:
+            # S = H_ss − Xᵀ X (lower triangle)
+            _syrk_corner(L, b, X[s - 1], sizes[s - 1])
+        if not _potrf_corner(L, b):
+            return False
+        if s + 1 < ns:
+            bn = sizes[s + 1]
+            Xs = X[s]
+            for i in range(b):
+                for c in range(bn):
+                    Xs[i, c] = Ho[s, i, c]
+            # X_s = L⁻¹ H_(s, s+1)
+            _trsm_corner(L, b, Xs, bn)
+    return True
+
+
+@_JIT
+def _btd_solve(Ld, X, sizes, offsets, x):
+    """x = (L Lᵀ)⁻¹ x in place (x (size,))."""
+    ns = sizes.shape[0]
+    for s in range(ns):
+        b = sizes[s]
+        o = offsets[s]
+        xs = x[o:o + b]
+        if s > 0:
+            bp = sizes[s - 1]
+            op = offsets[s - 1]
+            Xp = X[s - 1]
+            for r in range(bp):
+                v = x[op + r]
+                if v != 0.0:
+                    for i in range(b):
+                        xs[i] -= Xp[r, i] * v
+        _trsv_lower(Ld[s], b, xs)
+    for s in range(ns - 1, -1, -1):
+        b = sizes[s]
+        o = offsets[s]
+        xs = x[o:o + b]
+        if s + 1 < ns:
+            bn = sizes[s + 1]
+            on = offsets[s + 1]
+            Xs = X[s]
+            for i in range(b):
+                acc = 0.0
+                for c in range(bn):
+                    acc += Xs[i, c] * x[on + c]
+                xs[i] -= acc
+        _trsv_upper(Ld[s], b, xs)
+
+
+@_JIT
+def _btd_matvec(Ad, Ao, sizes, offsets, x, out, alpha):
+    """out += alpha A x for the symmetric block-tridiagonal A."""
+    ns = sizes.shape[0]
+    for s in range(ns):
+        b = sizes[s]
+        o = offsets[s]
+        for i in range(b):
+            acc = 0.0
+            for k in range(b):
+                acc += Ad[s, i, k] * x[o + k]
+            out[o + i] += alpha * acc
+        if s + 1 < ns:
+            bn = sizes[s + 1]
+            on = offsets[s + 1]
+            B = Ao[s]
+            for i in range(b):
+                acc = 0.0
+                xi = x[o + i]
+                for c in range(bn):
+                    acc += B[i, c] * x[on + c]
+                    out[on + c] += alpha * B[i, c] * xi
+                out[o + i] += alpha * acc
+
+
+@_JIT
+def _btd_combine(Md, Cd, Kd, Mo, Co, Ko, sizes, cm, cc, ck, Hd, Ho):
+    """H = cm M + cc C + ck K (block by block)."""
+    ns = sizes.shape[0]
+    for s in range(ns):
+        b = sizes[s]
+        for i in range(b):
+            for k in range(b):
+                Hd[s, i, k] = cm * Md[s, i, k] + cc * Cd[s, i, k] + ck * Kd[s, i, k]
+        if s + 1 < ns:
+            bn = sizes[s + 1]
+            for i in range(b):
+                for k in range(bn):
+                    Ho[s, i, k] = cm * Mo[s, i, k] + cc * Co[s, i, k] + ck * Ko[s, i, k]
