@@ -15,7 +15,7 @@ from seisrack.errors import InputError
 
 #: feature -> the rack dimensions it is built for
 FEATURES: dict[str, tuple[int, ...]] = {
-    "nonlinear connections ([hysteresis])": (2,),
+    "nonlinear connections ([hysteresis])": (2, 3),
     "velocity-dependent friction (friction_rate)": (2,),
     "exact modal propagators (method exact)": (2,),
     "a cross-aisle ground motion component": (3,),
