@@ -124,15 +124,25 @@ def _hyst_drive(law, par, thetas, m_out, k_out):
 
 
 @_JIT
-def _hyst_zwork(law, par, st_c, i, k, ta, tb, st_t):
-    """``∫ (M(θ) − k θ) dθ`` from ``ta`` to ``tb`` along the trial from the committed row ``i``
-    (the work of a hinge's correction force ``z = M − k θ`` over a trial rotation; the planar
-    step's line search needs it exactly). ``M(θ)`` is piecewise linear: a piece is integrated
-    by the trapezoid once both its ends lie on one line (the tangents and intercepts that
-    :func:`_hyst_trial_at` returns); otherwise it is split where the two end lines meet when
-    the law passes through that point (one kink), else in the middle. ``st_t`` is scratch."""
-    if ta == tb:
+def _hyst_zwork(law, par, st_c, i, k, ta, dt_, st_t):
+    """``∫ (M(θ) − k θ) dθ`` from ``ta`` to ``ta + dt_`` along the trial from the committed row
+    ``i`` (the work of a hinge's correction force ``z = M − k θ`` over a trial rotation; the
+    planar step's line search needs it exactly). ``M(θ)`` is piecewise linear: a piece is
+    integrated by the trapezoid once both its ends lie on one line (the tangents and
+    intercepts that :func:`_hyst_trial_at` returns); otherwise it is split where the two end
+    lines meet when the law passes through that point (one kink), else in the middle. On one
+    line the increment ``dt_`` is used as given (``ta + dt_ − ta`` loses it when it is far
+    below the rotation's last digit). ``st_t`` is scratch."""
+    if dt_ == 0.0:
         return 0.0
+    tb = ta + dt_
+    ma, ka = _hyst_trial_at(law, par, st_c, i, ta, st_t)
+    mb, kb = _hyst_trial_at(law, par, st_c, i, tb, st_t)
+    ca = ma - ka * ta
+    cb = mb - kb * tb
+    scale = abs(ma) + abs(mb) + abs(ka * ta) + abs(kb * tb) + 1e-300
+    if abs(ka - kb) <= 1e-12 * (abs(ka) + abs(kb)) and abs(ca - cb) <= 1e-12 * scale:
+        return dt_ * ((ma - k * ta) + 0.5 * (ka - k) * dt_)
     sgn = 1.0
     lo, hi = ta, tb
     if lo > hi:

@@ -342,8 +342,20 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         for i in range(nh):
             hmax = max(hmax, abs(dth[i]))
         hpot *= hmax
+        # and the round-off of lin1: the terms of rlin are far larger than rlin at short steps
+        for i in range(r):
+            hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i]))
+        # a full step below the stopping tolerance is taken as it is: backtracking would
+        # compare changes of the potential at the level of their round-off (at short
+        # steps, where 4/h² magnifies it) and could stop on a damped step short of the root
+        full = 0.0
+        for jf in range(nf):
+            full = max(full, abs(c2 * ps[jf]))
+        full = full / max(ymax, 1e-300)
+        for i in range(nh):
+            full = max(full, abs(dth[i]) / thsc)
         alpha = 1.0
-        for _ls in range(40):
+        for _ls in range(40 if full > 1e-12 else 0):
             hub1 = 0.0
             for a in range(n_slide):
                 p = sl[a]
@@ -353,7 +365,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
                                0.5 * h * mud[p] * N1[p] / mass[p], mass[p], h)
             for i in range(nh):  # the hinges' part of the potential: ∫ z dθ
                 hub1 += c2 * _hyst_zwork(hlaw[i], hpar, hst_c, i, hk[i], th[i],
-                                         th[i] + alpha * dth[i], hst_t)
+                                         alpha * dth[i], hst_t)
             dpi = alpha * lin1 + 0.5 * alpha * alpha * lin2 + (hub1 - hub0) / c2
             if dpi <= 1e-4 * alpha * slope + 1e-14 * (abs(hub0) / c2 + abs(lin2) + hpot):
                 break

@@ -201,8 +201,8 @@ def run_planar_scheme(
             hinges.initial_moment()[:nh])
     return TimeHistory(
         t=keep_idx * dt, q=kq, qd=kqd, qdd=kqdd, phi=phi, slider_u=None, slider_v=None,
-        sliding=ku.reshape(-1, m, 2), sliding_v=kv.reshape(-1, m, 2),
-        friction=kl.reshape(-1, m, 2), normal=kept_N, stuck=ks, energy=energy,
+        sliding=ku.reshape(len(ku), m, 2), sliding_v=kv.reshape(len(kv), m, 2),
+        friction=kl.reshape(len(kl), m, 2), normal=kept_N, stuck=ks, energy=energy,
         slider_dof=sliders.dof_x.copy(), events=events, status=status_text, backend=used,
         n_substeps=n_sub, method="newmark", basis=bas.describe(), sample_index=keep_idx,
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
