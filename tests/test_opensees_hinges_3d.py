@@ -14,8 +14,9 @@ seisrack's ``[second_order] p_delta = true, form = "p_delta_only"`` (the same ch
 constant), pallets rigid (OpenSees: their masses on their supports; seisrack:
 ``with_friction(spec, 1e6)``, no pallet slides), Newmark average acceleration with Newton
 (NormDispIncr 1e-10), the same dt = 5 ms, damping C = a1 K_initial. Ground motion: El Centro
-1940 N-S × 1.5 down-aisle and the same record 4 s later × 1.5 cross-aisle, 20 s, then 20 s of
-free vibration; both programs interpolate the 10 ms record linearly.
+1940 N-S × 1.5 down-aisle and the same record 4 s later × 1.5 cross-aisle, 30 s, then 30 s of
+free vibration (20 s did not settle the elastic-plastic rack: 5.3 % of its drift in the last
+2 s); both programs interpolate the 10 ms record linearly.
 
 Compared (acceptance of issue 21: within 2 %): the peak level displacement in each direction,
 the residual down-aisle drift (the mean of the last 2 s, settled), and the peak moment of every
@@ -23,11 +24,14 @@ connector; the base plates' peak moments too, and a cross-aisle base plate must 
 cross-aisle ground motion bends the base plates about x past their yield).
 
 The laws: (a) elastic-perfectly plastic connectors (My 2.5 kN·m) and base plates (My 60 N·m:
-the base plates are all but pinned down-aisle, and yield cross-aisle too). The P-Δ post-yield
-response of such a rack is a ratchet whose residual drift differs between seisrack's P-Δ (the
-geometric stiffness of the gravity axial forces, constant) and OpenSees' PDelta (the current
-axial force of each member): measured 15.6 % on the residual drift with P-Δ, 1.2 % without it
-(peaks within 0.1 % either way), so case (a) runs with P-Δ off and case (b) with P-Δ on.
+the base plates are all but pinned down-aisle, and yield cross-aisle too), P-Δ off. With P-Δ
+the residual drift of such a rack (a flat post-yield branch: P-Δ makes it ratchet) was
+measured 15.6 % off (4.1 % with base plates of 1 kN·m), its peak displacement within 0.25 %
+(one connector's peak moment 3.8 % off with the 60 N·m base plates): seisrack's
+damping is a1 K with the geometric stiffness in K, OpenSees' a1 K_initial without it, and the
+ratchet magnifies that (on the 2D paper rack with EPP hinges and P-Δ: residual drift 0.59 %
+off with seisrack's C, 0.09 % with C = a1 K_E, which the planar scheme cannot take: it needs
+damping that is classical in its basis). So case (a) runs with P-Δ off and case (b) with it.
 (b) the pinched law without damage on the connectors (asymmetric, as in
 ``tests/test_opensees_hinges.py``) and a hardening pinched envelope on the base plates
 (yield at 0.3 mrad, 48 N·m, then 0.7, 1.8, 2.6 kN·m at 5, 15, 40 mrad), so that the base
@@ -37,7 +41,9 @@ Differences that remain are model differences, not the integration: a rigid pall
 seisrack moves with the mean of its supports (a mass on the mean), in OpenSees its mass is
 split on the supports; the two differ when the front and rear beams move differently (in
 cross-aisle bending of the frames): the moment histories of the cross-aisle base plates differ
-by 3.4 % of their peak in both cases, their peaks by 0.2 % at most.
+by 3.4 % of their peak in both cases, their peaks by 0.2 % at most. With P-Δ (b) the damping
+convention above adds to it: the connectors' moment histories differ by up to 4 % of their
+peak in (b), 0.4 % in (a).
 """
 
 from __future__ import annotations
@@ -60,10 +66,10 @@ ROOT = Path(__file__).resolve().parents[1]
 RACK = ROOT / "examples" / "paper_rack_3d.toml"
 K_CONNECTION = 160e3  # N·m/rad, [connections] of the paper rack (Table 1)
 DT = 0.005
-SECONDS = 20.0
+SECONDS = 30.0
 SHIFT = 4.0  # s: the cross-aisle component is the record this much later
 SCALE = 1.5
-FREE_VIBRATION = 20.0
+FREE_VIBRATION = 30.0
 TOL = 0.02  # issue 21
 
 CASES = {
@@ -159,7 +165,9 @@ def test_residual_drift_within_2_percent(pair) -> None:
     case, res, ops = pair
     s = _settled(res.beam_displacement[:, 0, 0])
     o = _settled(ops["level_displacement"][:, 0])
-    assert abs(o) > 4e-4  # a permanent drift, not noise
+    # a settled permanent drift (measured: 0.41 mm for the elastic-plastic case, its peak
+    # 93 mm; 10.5 mm for the pinched one, peak 67 mm)
+    assert abs(o) > 2e-4
     assert abs(s / o - 1) < TOL, f"{case}: seisrack {s:.6f} m, OpenSees {o:.6f} m"
 
 

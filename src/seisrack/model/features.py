@@ -3,7 +3,7 @@
 A 2D (plane) rack and a 3D (space) rack are the same kind of thing and take the same path; a
 capability that exists for one dimension only is listed here, and asking for it on the other
 raises an :class:`~seisrack.errors.InputError` that names the feature and the field that asked
-for it ("nonlinear connections are not built for 3D racks yet"), never a type check.
+for it ("velocity-dependent friction is not built for 3D racks yet"), never a type check.
 """
 
 from __future__ import annotations
