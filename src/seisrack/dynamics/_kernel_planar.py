@@ -52,13 +52,8 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _start_values,
         _track_direction,
     )
-    from seisrack.dynamics._planar_step import (
-        _hinge_commit_at,
-        _hinge_committed,
-        _minus_qtz,
-        _sample_row,
-        _trial,
-    )
+    from seisrack.dynamics._planar_hinges import _hinge_commit_at, _hinge_committed, _minus_qtz
+    from seisrack.dynamics._planar_step import _sample_row, _trial
 
 #: status of a Newton iteration of the planar step that did not converge
 STATUS_PLANAR_NEWTON = 4
