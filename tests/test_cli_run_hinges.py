@@ -194,3 +194,58 @@ def test_linear_rack_outputs_have_no_hinges(tmp_path):
     rc, text = _main("run", str(PAPER_RACK), "--motion", str(rec))
     assert "Connections" not in text and "hinge law" not in text
     assert "connector moment" in text
+
+
+NONLINEAR_3D = Path(__file__).resolve().parents[1] / "examples" / "paper_rack_3d_nonlinear.toml"
+
+
+def test_3d_rack_run_report_and_export_have_the_hinges(tmp_path):
+    """examples/paper_rack_3d_nonlinear.toml (issue 21): 8 connectors in down-aisle bending and
+    6 base plates about both axes, in every output of run and report, and in the export."""
+    pytest.importorskip("xarray")
+    pytest.importorskip("matplotlib")
+    import numpy as np
+    import xarray as xr
+
+    from seisrack.motion import Record
+
+    full = short_record(14.0)
+    a = record_csv(tmp_path / "x.csv", short_record(10.0))
+    b = record_csv(tmp_path / "z.csv", Record(full.accel[400:1401], full.dt, name="shifted"))
+    out = tmp_path / "out"
+    rc, text = _main("run", str(NONLINEAR_3D), "--motion", str(a), "--motion-cross", str(b),
+                     "--out", str(out), "--json")
+    assert rc == 0
+    s = json.loads(text)
+    h = s["hinges"]
+    labels = {r["hinge"] for r in h["hinges"]}
+    assert h["count"] == 20 and len(labels) == 20
+    assert "base U2-front cross-aisle" in labels and "base U2-rear down-aisle" in labels
+    assert "connector L1 B1-front left" in labels and "connector L1 B2-rear right" in labels
+    assert h["yielded"] >= 4 and s["energy_J"]["hysteresis"] > 0.0
+    assert s["energy_balance_error"] < 1e-6
+    rows = [r for r in _peaks_csv(out) if r["quantity"] == "hinge_moment"]
+    assert len(rows) == 20
+    conn = [r for r in _peaks_csv(out) if r["quantity"] == "connector_moment_Nm"]
+    assert conn and all("hinge law" in r["note"] for r in conn)  # the law's moments, <= My
+    assert max(float(r["value"]) for r in conn) == pytest.approx(1500.0, rel=1e-9)
+    with xr.open_dataset(out / "timehistory.nc") as ds:
+        assert ds.hinge_moment.dims == ("time", "hinge") and ds.hinge.size == 20
+        assert float(np.max(np.abs(ds.hinge_moment.values))) <= 1800.0 * (1 + 1e-12)
+    assert (out / "hinge_loops.png").stat().st_size > 10_000
+    html = tmp_path / "report.html"
+    rc, _ = _main("report", str(NONLINEAR_3D), "--motion", str(a), "--motion-cross", str(b),
+                  "--out", str(html), "--json")
+    assert rc == 0
+    sec = html.read_text(encoding="utf-8")
+    sec = sec[sec.index('<section id="connections">'):]
+    assert sec[:sec.index("</section>")].count("<tr data-hinge=") == 20
+    script = tmp_path / "ops.py"
+    rc, _ = _main("export", "opensees", str(NONLINEAR_3D), "--out", str(script))
+    assert rc == 0
+    text = script.read_text(encoding="utf-8")
+    body = text[text.index("SPRINGS = ["):text.index("# per spring, uniaxialMaterial")]
+    dirs = [int(x) for x in re.findall(r"\(\d+, \d+, (\d), [\d.e+]+\)", body)]
+    # base plates about x (rx, 4) and z (rz, 6), connectors about z: 6 + 14
+    assert sorted(dirs) == [4] * 6 + [6] * 14
+    assert text.count("('ElasticPP', 160000.0,") == 20

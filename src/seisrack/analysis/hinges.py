@@ -72,24 +72,38 @@ def rack_hinges(model: FrameModel) -> Hinges | None:
 
 
 def hinge_labels(model: FrameModel) -> tuple[str, ...]:
-    """A readable name per hinge: its beam (level, bay, end) or its upright (base)."""
+    """A readable name per hinge: its beam (level, bay, end) or its upright (base); on a 3D
+    rack also its frame, named as the design quantities name it (``-front``, ``-rear``,
+    ``-R2-front``: :func:`~seisrack.fe.recovery.side_names`) and, for a base plate, the plane
+    it bends in ("down-aisle": about z, "cross-aisle": about x)."""
+    from seisrack.fe.recovery import side_names
+
     assert model.hinge_dofs is not None and model.hinge_kind is not None
-    rz = model.node_dofs[:, 2]
+    rot = model.node_dofs[:, -1]  # rotation in the down-aisle (x-y) plane: rz
     el = model.elements
     x_up = model.upright_x
+    three_d = model.ndm == 3
+    frame_z = np.asarray(model.frame_z if three_d and model.frame_z is not None else [0.0])
+    names = side_names(frame_z.size)
     labels = []
     for (a, _b), kind, node in zip(model.hinge_dofs, model.hinge_kind, model.hinge_node,
                                    strict=True):
         col = int(np.argmin(np.abs(x_up - model.nodes[node, 0])))
+        frame = names[int(np.argmin(np.abs(frame_z - model.nodes[node, 2])))] if three_d \
+            else ""
         if kind == BASE_PLATE:
-            labels.append(f"base U{col + 1}")
+            plane = ""
+            if three_d:
+                plane = " down-aisle" if a == rot[node] else " cross-aisle"
+            labels.append(f"base U{col + 1}{frame}{plane}")
             continue
-        beam_nodes = np.flatnonzero(rz == a)
+        beam_nodes = np.flatnonzero(rot == a)
         hit = np.flatnonzero((model.element_kind == BEAM)
                              & (np.isin(el[:, 0], beam_nodes) | np.isin(el[:, 1], beam_nodes)))
         e = int(hit[0])
         bay, lev = int(model.element_line[e]), int(model.element_storey[e])
-        labels.append(f"connector L{lev + 1} B{bay + 1} {'left' if col == bay else 'right'}")
+        labels.append(f"connector L{lev + 1} B{bay + 1}{frame} "
+                      f"{'left' if col == bay else 'right'}")
     return tuple(labels)
 
 
@@ -141,7 +155,8 @@ def nonlinear_connector_design(design: dict, hinges: HingeResponse) -> None:
     col = {lab: i for i, lab in enumerate(hinges.labels)}
     rows = []
     for lab in entry["labels"]:
-        lev, bay, end = lab.split("-")
+        lev, rest = lab.split("-", 1)  # "L1-B2-left", 3D "L1-B2-front-left"
+        bay, end = rest.rsplit("-", 1)
         i = col.get(f"connector {lev} {bay} {end}")
         if i is None:
             return  # not every connector is a hinge: keep the elastic entry

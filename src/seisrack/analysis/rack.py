@@ -184,7 +184,7 @@ def run_rack(
         hist = simulate(model.M_sparse, model.C_sparse, model.K_sparse, sliders, **common,
                         progress=progress, save_every=save_every, on_chunk=on_chunk,
                         track_energy=track_energy, max_memory=max_memory,
-                        **({"hinges": hinges} if line else {}))
+                        hinges=hinges)
     except InputError as exc:
         if not exc.field.startswith("sliders.friction_rate["):
             raise
@@ -206,8 +206,7 @@ def run_rack(
         if line:
             common["method"] = "exact" if hist.method == "exact" else method
         simulate(model.M_sparse, model.C_sparse, model.K_sparse, held, **common,
-                 save_every=None, on_chunk=rig, track_energy=False,
-                 **({"hinges": hinges} if line else {}))
+                 save_every=None, on_chunk=rig, track_energy=False, hinges=hinges)
         rigid_peak = rig.result()["beam_acceleration_magnitude"]
     resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])

@@ -230,12 +230,13 @@ def _hinge_lines(hinges: dict[str, Any] | None, energy: dict[str, float]) -> lis
     """The nonlinear connections: one line per hinge and the hysteretic energy."""
     if not hinges:
         return []
+    w = max([24] + [len(r["hinge"]) + 1 for r in hinges["hinges"]])
     out = ["", "Connections (nonlinear; rotation from the zero-moment state, gravity included)",
-           f"  {'hinge':<24} {'law':<16} {'peak rot [mrad]':>15} {'peak M [kN·m]':>13} "
+           f"  {'hinge':<{w}} {'law':<16} {'peak rot [mrad]':>15} {'peak M [kN·m]':>13} "
            f"{'residual [mrad]':>15} {'ductility':>9}"]
     for r in hinges["hinges"]:
         duct = "-" if r["ductility"] is None else f"{r['ductility']:.2f}"
-        out.append(f"  {r['hinge']:<24} {r['law']:<16} {r['peak_rotation_rad'] * 1e3:>15.2f} "
+        out.append(f"  {r['hinge']:<{w}} {r['law']:<16} {r['peak_rotation_rad'] * 1e3:>15.2f} "
                    f"{r['peak_moment_Nm'] * 1e-3:>13.3f} "
                    f"{r['residual_rotation_rad'] * 1e3:>15.2f} {duct:>9}"
                    + ("  YIELDED" if r["yielded"] else ""))

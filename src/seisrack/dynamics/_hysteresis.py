@@ -121,3 +121,71 @@ def _hyst_drive(law, par, thetas, m_out, k_out):
         for j in range(n):
             st_c[j] = st_t[j]
     return st_c[HYST_S_WORK]
+
+
+@_JIT
+def _hyst_zwork(law, par, st_c, i, k, ta, dt_, st_t):
+    """``∫ (M(θ) − k θ) dθ`` from ``ta`` to ``ta + dt_`` along the trial from the committed row
+    ``i`` (the work of a hinge's correction force ``z = M − k θ`` over a trial rotation; the
+    planar step's line search needs it exactly). ``M(θ)`` is piecewise linear: a piece is
+    integrated by the trapezoid once both its ends lie on one line (the tangents and
+    intercepts that :func:`_hyst_trial_at` returns); otherwise it is split where the two end
+    lines meet when the law passes through that point (one kink), else in the middle. On one
+    line the increment ``dt_`` is used as given (``ta + dt_ − ta`` loses it when it is far
+    below the rotation's last digit). ``st_t`` is scratch."""
+    if dt_ == 0.0:
+        return 0.0
+    tb = ta + dt_
+    ma, ka = _hyst_trial_at(law, par, st_c, i, ta, st_t)
+    mb, kb = _hyst_trial_at(law, par, st_c, i, tb, st_t)
+    ca = ma - ka * ta
+    cb = mb - kb * tb
+    scale = abs(ma) + abs(mb) + abs(ka * ta) + abs(kb * tb) + 1e-300
+    if abs(ka - kb) <= 1e-12 * (abs(ka) + abs(kb)) and abs(ca - cb) <= 1e-12 * scale:
+        return dt_ * ((ma - k * ta) + 0.5 * (ka - k) * dt_)
+    sgn = 1.0
+    lo, hi = ta, tb
+    if lo > hi:
+        lo, hi = tb, ta
+        sgn = -1.0
+    stack = np.empty((48, 2))
+    stack[0, 0] = lo
+    stack[0, 1] = hi
+    top = 1
+    total = 0.0
+    for _ in range(200):
+        if top == 0:
+            break
+        top -= 1
+        a = stack[top, 0]
+        b = stack[top, 1]
+        ma, ka = _hyst_trial_at(law, par, st_c, i, a, st_t)
+        mb, kb = _hyst_trial_at(law, par, st_c, i, b, st_t)
+        ca = ma - ka * a
+        cb = mb - kb * b
+        scale = abs(ma) + abs(mb) + abs(ka * a) + abs(kb * b) + 1e-300
+        if (abs(ka - kb) <= 1e-12 * (abs(ka) + abs(kb)) and abs(ca - cb) <= 1e-12 * scale) \
+                or b - a <= 1e-14 * (abs(a) + abs(b)) or top >= 46:
+            total += 0.5 * ((ma - k * a) + (mb - k * b)) * (b - a)
+            continue
+        if ka != kb:
+            x = (cb - ca) / (ka - kb)
+            if a < x < b:
+                mx, _kx = _hyst_trial_at(law, par, st_c, i, x, st_t)
+                if abs(mx - (ka * x + ca)) <= 1e-12 * scale:
+                    total += 0.5 * ((ma - k * a) + (mx - k * x)) * (x - a)
+                    total += 0.5 * ((mx - k * x) + (mb - k * b)) * (b - x)
+                    continue
+        mid = 0.5 * (a + b)
+        stack[top, 0] = a
+        stack[top, 1] = mid
+        stack[top + 1, 0] = mid
+        stack[top + 1, 1] = b
+        top += 2
+    for t in range(top):  # not reached in practice: the trapezoid on what is left
+        a = stack[t, 0]
+        b = stack[t, 1]
+        ma, _ka = _hyst_trial_at(law, par, st_c, i, a, st_t)
+        mb, _kb = _hyst_trial_at(law, par, st_c, i, b, st_t)
+        total += 0.5 * ((ma - k * a) + (mb - k * b)) * (b - a)
+    return sgn * total

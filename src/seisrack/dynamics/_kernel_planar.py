@@ -52,6 +52,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _start_values,
         _track_direction,
     )
+    from seisrack.dynamics._planar_hinges import _hinge_commit_at, _hinge_committed, _minus_qtz
     from seisrack.dynamics._planar_step import _sample_row, _trial
 
 #: status of a Newton iteration of the planar step that did not converge
@@ -71,7 +72,8 @@ _SPAN = 1e-6
 def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state, S_state,
                stuck, dirn, S, A, fac, t_offset, max_events, max_substeps,
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
-               ev_time, ev_pallet, ev_kind, stats):
+               ev_time, ev_pallet, ev_kind, stats,
+               Q, hth0, hk, hlaw, hpar, hst, HW, e_state, out_hm, out_energy):
     """Integrate ``agx.shape[0] - 1`` steps. Returns (status, n_events, n_substeps, the last
     output row written).
 
@@ -85,6 +87,15 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     steps, Newton iterations, Cholesky factorisations and location trials. Outputs per step
     (n_t rows): q, qd, qdd, u (sliding displacement w - P q), v (relative velocity), lam
     (friction force on the pallet), stuck.
+
+    Nonlinear hinges (``docs/theory/planar_friction.md`` §7): ``Q`` (n_h, r) their rotations
+    of the basis coordinates, ``hth0`` (n_h,) their rotations at q = 0, ``hk`` their elastic
+    stiffness (in ``kd``), ``hlaw``, ``hpar`` their laws, ``hst`` (n_h, HYST_NSTATE) their
+    committed states (read and written back, as the pallets' state), ``HW`` (4, n_h) scratch
+    that goes with ``A``; ``out_hm`` (n_t, n_h) their moments. Energy (cumulative from the
+    start of the run, resumed from ``e_state``: input, damping, friction, the hinges'
+    correction work ∫ z dθ): ``out_energy`` (n_t, 5) columns input, kinetic, strain (with the
+    hinges' correction work), damping, friction.
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -123,7 +134,21 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     n_ev = 0
     n_sub = 0
     status = STATUS_OK
+    nh = hk.shape[0]
+    hst_t = hst.copy()
+    hM = np.empty(nh)  # committed moments and corrections
+    hz = np.empty(nh)
+    hMt = np.empty(nh)  # a trial's
+    hzt = np.empty(nh)
+    _hinge_committed(hst, hk, hM, hz)
+    pz = np.empty(r)  # a modal load with the hinges' corrections moved over
+    pea = np.empty(r)
+    peb = np.empty(r)
+    dqe = np.empty(r)
+    ena = np.empty(2)
+    E_in, E_damp, E_fric, E_z = e_state[0], e_state[1], e_state[2], e_state[3]
     if not resume:
+        E_in, E_damp, E_fric, E_z = 0.0, 0.0, 0.0, 0.0
         # pallets start stuck, moving with their supports
         stuck[:] = False
         S[:, :] = 0.0
@@ -140,7 +165,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
         old_stuck[:] = False
         ag[0] = agx[0]
         ag[1] = agz[0]
-        _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext[0], N[0], stuck, dirn,
+        _minus_qtz(pext[0], Q, hz, pz)
+        _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pz, N[0], stuck, dirn,
                 cand, forced, A, pe, forced)
         for p in range(m):
             old_stuck[p] = True  # "slip" at t = 0 for pallets released at once
@@ -149,6 +175,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                        ev_time, ev_pallet, ev_kind)
         _fill_relative(P, T0, S0)
     _output(0, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck)
+    out_hm[0, :] = hM
+    _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
     k_done = 0
     n_tr = np.zeros(m, dtype=np.int64)
     frozen = np.zeros(m, dtype=np.bool_)
@@ -168,7 +196,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 dqg[i] = hrem * T0[1, i] + 0.5 * hrem * hrem * T0[2, i]
             ok = _trial(hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag,
                         pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF, stats,
-                        dqg, True, fac)
+                        dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt, hzt, HW)
             _mask_frozen(frozen, e_hi)
             if ok != 0:
                 status = STATUS_PLANAR_NEWTON + ok - 1
@@ -220,7 +248,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                                 2.0 * T0[2, i] + th * (qdd_full[i] - T0[2, i]))
                     ok = _trial(th * hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck,
                                 dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G, PF, stats,
-                                dqg, warm, fac)
+                                dqg, warm, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt,
+                                hzt, HW)
                     dqb[:] = dqa
                     thb = tha
                     tha = th
@@ -235,8 +264,28 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 if status != STATUS_OK:
                     break
                 th_hi = _bracket_end(br, T1, S1, Tb, Sb)
+            # the work over the accepted sub-step [tau, tau_end] (Newmark's energy identity:
+            # forces averaged over its two ends, which is exact for the trapezoidal rule)
+            tau_e = _substep_end(tau, th_hi, any_ev)
+            _sample_row(pext, k, tau, pea)
+            _sample_row(pext, k, tau_e, peb)
+            ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau) + _interp(agx[k], agx[k + 1], tau_e))
+            ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau) + _interp(agz[k], agz[k + 1], tau_e))
+            for i in range(r):
+                dqe[i] = T1[0, i] - T0[0, i]
+                E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
+                E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
+            vrel = np.dot(P, dqe)
+            for p in range(m):
+                for c in range(2):
+                    j = 2 * p + c
+                    dw = S1[0, j] - S0[0, j]
+                    E_in -= mass[p] * dw * ena[c]
+                    E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
             T0[:] = T1
             S0[:] = S1
+            if nh > 0:
+                E_z += _hinge_commit_at(Q, hth0, hk, hlaw, hpar, hst, hst_t, T0[0], hM, hz)
             _track_direction(stuck, S0, dirn)
             tau = _substep_end(tau, th_hi, any_ev)
             if any_ev:
@@ -249,7 +298,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                     c_full[p] = 0.5 * dt * mud[p] * Ne[p] / mass[p]
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
-                _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pe, Ne, stuck, dirn,
+                _minus_qtz(pe, Q, hz, pz)
+                _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pz, Ne, stuck, dirn,
                         cand, forced, A, W[10, :r], frozen)
                 fac[0] = -1.0
                 for p in range(m):
@@ -275,6 +325,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
             break
         _output(k + 1, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam,
                 out_stuck)
+        out_hm[k + 1, :] = hM
+        _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
         k_done = k + 1
         if not np.isfinite(T0[0, 0]):
             status = STATUS_NONFINITE
@@ -283,4 +335,25 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
         status = STATUS_EVENT_OVERFLOW
     T_state[:] = T0
     S_state[:] = S0
+    e_state[0] = E_in
+    e_state[1] = E_damp
+    e_state[2] = E_fric
+    e_state[3] = E_z
     return status, n_ev, n_sub, k_done
+
+
+@_JIT
+def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy):
+    """Row ``k`` of the energy output: input, kinetic (structure and pallets, relative to the
+    ground), strain (½ qᵀ kd q plus the hinges' correction work), damping, friction."""
+    kin = 0.5 * np.dot(T0[1], T0[1])
+    for p in range(mass.shape[0]):
+        kin += 0.5 * mass[p] * (S0[1, 2 * p] ** 2 + S0[1, 2 * p + 1] ** 2)
+    strain = E_z
+    for i in range(kd.shape[0]):
+        strain += 0.5 * kd[i] * T0[0, i] * T0[0, i]
+    out_energy[k, 0] = E_in
+    out_energy[k, 1] = kin
+    out_energy[k, 2] = strain
+    out_energy[k, 3] = E_damp
+    out_energy[k, 4] = E_fric

@@ -2,8 +2,11 @@
 shared by the numba and pure-Python backends; theory: ``docs/theory/planar_friction.md`` §2).
 
 ``_trial`` advances the structure (basis coordinates) and the pallets by one (sub)step; a
-sliding pallet's end force comes from the return map onto its friction disc, and the step
-equation (the gradient of a convex potential) is solved by Newton's method with backtracking.
+sliding pallet's end force comes from the return map onto its friction disc, a nonlinear
+hinge's from its hysteresis law (the correction ``z = M(θ) − k θ`` to the elastic spring kept in
+``kd``, as on a line: ``docs/theory/nonlinear_hinges.md``), and the step equation (the
+gradient of a potential, convex for the monotone laws) is solved by Newton's method with
+backtracking (``docs/theory/planar_friction.md`` §7).
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
@@ -14,6 +17,8 @@ try:  # names injected by the loader when executed after ``_events.py``
     _interp  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, _interp
+    from seisrack.dynamics._hysteresis import _hyst_trial_at, _hyst_zwork
+    from seisrack.dynamics._planar_hinges import _hinge_eval, _minus_qtz
     from seisrack.dynamics._planar_lapack import _chol, _syrk_lower
 
 _NEWTON_MAX = 40
@@ -123,7 +128,8 @@ def _huber(yx, yz, cc, mp, h):
 
 @_JIT
 def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1, N1,
-           T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac):
+           T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
+           Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW):
     """One Newmark step of length ``h`` with a fixed contact state, from (T0, S0) to (T1, S1).
 
     T rows: q, qd, qdd (r); S rows: w, wd, wdd, lam, s (relative velocity), vn (support
@@ -137,6 +143,14 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     warm trial within 0.1 % of that length starts with chord steps on it. Returns 0, or 1 when
     the step matrix is not positive definite, 2 when Newton's iteration on the sliding
     directions did not converge. Products with ``P`` and ``S`` go through BLAS.
+
+    Nonlinear hinges (n_h = ``hk.shape[0]``, possibly 0): ``Q`` (n_h, r) their rotations of the
+    basis coordinates, ``hth0`` the rotations at q = 0, ``hk`` the elastic stiffness in ``kd``,
+    ``hlaw``, ``hpar``, ``hst_c`` their laws and committed states, ``hz_c`` the committed
+    corrections (the first iterate's); written: the trial states ``hst_t``, moments ``hM`` and
+    corrections ``hz`` at the end of the step. ``HW`` (4, n_h) is scratch (its last row goes with
+    ``A``: the tangents in its factor). Their forces
+    ``−Qᵀ z(θ)`` enter the residual, their tangents ``Qᵀ (k_t − k) Q`` the Newton matrix.
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -149,6 +163,11 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     rhs, dq, res, stp, rlin, dg = W[0, :r], W[1, :r], W[2, :r], W[3, :r], W[4, :r], W[5, :r]
     zf, lam, pd, ps = W[6, :m2], W[7, :m2], W[8, :m2], W[9, :m2]
     stats[0] += 1
+    nh = hk.shape[0]
+    thb, th, dth = HW[0], HW[1], HW[2]  # hinge rotations at dq = 0, now, and along a step
+    kfac = HW[3]  # the hinges' k_t − k in the factor held in A (kept across calls, as A is)
+    for i in range(nh):
+        thb[i] = hth0[i] + np.dot(Q[i], q0)
     for i in range(r):
         dg[i] = c0 + c2 * cd[i] + kd[i]
         rhs[i] = pext1[i] + c1 * qd0[i] + qdd0[i] + cd[i] * qd0[i] - kd[i] * q0[i]
@@ -182,7 +201,8 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
             lam[jf] = -mud[p] * N1[p] * dirn[j]  # first iterate: the current direction
     zf, lam, pd, ps = zf[:nf], lam[:nf], pd[:nf], ps[:nf]
     refac = True
-    if warm and n_slide > 0:
+    nonlin = n_slide > 0 or nh > 0
+    if warm and nonlin:
         dq[:] = dq_start
         # within 0.1 % of the factorised step length, the matrix moves by about 0.2 %
         refac = not (fac[0] > 0.0 and abs(h - fac[0]) <= 1e-3 * h)
@@ -190,23 +210,41 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         fac[0] = -1.0
         # first iterate: the linear step with the friction of the start of the step
         res[:] = rhs - np.dot(lam, PFs)
+        _minus_qtz(res, Q, hz_c, res)
         _a_lin(A, S, c0, c2, cd, kd)
         stats[2] += 1
         if not _chol(A):
             return 1
         _chol_solve(A, res)
         dq[:] = res
-    converged = n_slide == 0
+        kfac[:] = 0.0
+        # the factor is exact while no pallet slides and every hinge stays on a branch of its
+        # elastic stiffness: no refactorisation then (decided at the first iteration)
+        refac = n_slide > 0
+    converged = not nonlin
     last = 1e300
     # Semismooth Newton on dq: R = rhs - A_lin dq - sum_F P_pᵀ lam_p(y_p) = 0 with
     # y_p = zf_p - c2 P_p dq. R is minus the gradient of a strictly convex potential (the
     # friction term is a Huber function of y_p): Newton's steps are damped by backtracking on
     # it, which cures the cycling of plain Newton across the disc
     sd = np.empty(r)  # S dq, and pd = PF dq: updated with the steps of dq
-    for _it in range(_NEWTON_MAX if n_slide > 0 else 0):
+    for _it in range(_NEWTON_MAX if nonlin else 0):
         if _it == 0:
             pd[:] = np.dot(PFs, dq)
             sd[:] = np.dot(Ss, dq)
+        # the hinges at this iterate: moments, corrections and tangents (th, dth: scratch)
+        thsc = 1e-300
+        hpot = 0.0
+        for i in range(nh):
+            th[i] = thb[i] + np.dot(Q[i], dq)
+            mi, kt = _hyst_trial_at(hlaw[i], hpar, hst_c, i, th[i], hst_t)
+            hM[i] = mi
+            hz[i] = mi - hk[i] * th[i]
+            dth[i] = kt - hk[i]
+            if dth[i] != kfac[i]:
+                refac = True  # a hinge changed branch: its tangent is not in the factor
+            thsc = max(thsc, abs(th[i]) + abs(mi) / hk[i])
+            hpot += abs(mi) + hk[i] * abs(th[i])
         for i in range(r):
             rlin[i] = rhs[i] - dg[i] * dq[i] - c0 * sd[i]
         ymax = 0.0
@@ -222,9 +260,19 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
             hub0 += _huber(yx, yz, 0.5 * h * mud[p] * N1[p] / mass[p], mass[p], h)
             ymax = max(ymax, abs(zf[jx]) + abs(zf[jx + 1]) + mud[p] * N1[p] * h / mass[p])
         res[:] = rlin - np.dot(lam, PFs)
+        _minus_qtz(res, Q, hz, res)
         if refac:
             _a_lin(A, S, c0, c2, cd, kd)
             _syrk_lower(A, G, ng)
+            for i in range(nh):  # the hinges' tangents: Qᵀ diag(k_t − k) Q (lower triangle)
+                d = dth[i]
+                if d != 0.0:
+                    for a in range(r):
+                        da = d * Q[i, a]
+                        if da != 0.0:
+                            for b in range(a + 1):
+                                A[a, b] += da * Q[i, b]
+            kfac[:] = dth[:nh]
             stats[2] += 1
             if not _chol(A):
                 return 1
@@ -241,8 +289,26 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         for i in range(r):
             lin2 += stp[i] * (dg[i] * stp[i] + c0 * ss[i])
         ps[:] = np.dot(PFs, stp)
+        for i in range(nh):
+            dth[i] = np.dot(Q[i], stp)
+        hmax = 0.0
+        for i in range(nh):
+            hmax = max(hmax, abs(dth[i]))
+        hpot *= hmax
+        # and the round-off of lin1: the terms of rlin are far larger than rlin at short steps
+        for i in range(r):
+            hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i]))
+        # a full step below the stopping tolerance is taken as it is: backtracking would
+        # compare changes of the potential at the level of their round-off (at short
+        # steps, where 4/h² magnifies it) and could stop on a damped step short of the root
+        full = 0.0
+        for jf in range(nf):
+            full = max(full, abs(c2 * ps[jf]))
+        full = full / max(ymax, 1e-300)
+        for i in range(nh):
+            full = max(full, abs(dth[i]) / thsc)
         alpha = 1.0
-        for _ls in range(40):
+        for _ls in range(40 if full > 1e-12 else 0):
             hub1 = 0.0
             for a in range(n_slide):
                 p = sl[a]
@@ -250,8 +316,11 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
                 hub1 += _huber(zf[jx] - c2 * (pd[jx] + alpha * ps[jx]),
                                zf[jx + 1] - c2 * (pd[jx + 1] + alpha * ps[jx + 1]),
                                0.5 * h * mud[p] * N1[p] / mass[p], mass[p], h)
+            for i in range(nh):  # the hinges' part of the potential: ∫ z dθ
+                hub1 += c2 * _hyst_zwork(hlaw[i], hpar, hst_c, i, hk[i], th[i],
+                                         alpha * dth[i], hst_t)
             dpi = alpha * lin1 + 0.5 * alpha * alpha * lin2 + (hub1 - hub0) / c2
-            if dpi <= 1e-4 * alpha * slope + 1e-14 * (abs(hub0) / c2 + abs(lin2)):
+            if dpi <= 1e-4 * alpha * slope + 1e-14 * (abs(hub0) / c2 + abs(lin2) + hpot):
                 break
             alpha *= 0.5
         step = 0.0
@@ -261,11 +330,15 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         for jf in range(nf):
             pd[jf] += alpha * ps[jf]
             step = max(step, abs(c2 * alpha * ps[jf]))
+        # relative to the scales: the pallets' velocities, the hinges' rotations
+        step = step / max(ymax, 1e-300)
+        for i in range(nh):
+            step = max(step, abs(alpha * dth[i]) / thsc)
         # converged when this step, or the next one estimated from the contraction of the
         # last two full steps (Newton's is superlinear), is below 1e-12 (1e-11) of the scale
-        if step <= 1e-12 * ymax + 1e-300 or (
+        if step <= 1e-12 or (
                 alpha == 1.0 and last < 1e300 and step <= 0.1 * last
-                and step * (step / last) <= 1e-11 * ymax):
+                and step * (step / last) <= 1e-11):
             converged = True
             break
         # the next iteration keeps this factor (a chord step) while the full steps are small
@@ -273,6 +346,10 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         refac = not (alpha == 1.0 and ((last < 1e300 and step <= 0.2 * last)
                                        or _it == 0))
         last = step if alpha == 1.0 else 1e300
+    if nh > 0:  # the hinges at the final iterate
+        for i in range(r):
+            x0[i] = q0[i] + dq[i]
+        _hinge_eval(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, x0, hM, hz)
     if n_slide > 0:
         for a in range(n_slide):
             jx = 2 * a

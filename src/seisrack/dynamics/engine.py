@@ -47,7 +47,6 @@ _PLANAR_UNSUPPORTED = {
     "force": "applied forces",
     "u0": "an initial displacement",
     "v0": "an initial velocity",
-    "hinges": "nonlinear hinges",
     "method": "the exact modal propagators",
 }
 #: what each scheme supports beyond the ground motion, for the documentation and the refusals
@@ -55,8 +54,8 @@ SCHEME_FEATURES = {
     "line": ("ground motion", "vertical motion", "applied forces", "initial state",
              "exact propagators", "Newmark", "nonlinear hinges", "velocity-dependent friction",
              "energy balance", "reduced basis", "chunks"),
-    "planar": ("ground motion in two directions", "vertical motion", "Newmark", "reduced basis",
-               "chunks", "work counters"),
+    "planar": ("ground motion in two directions", "vertical motion", "Newmark",
+               "nonlinear hinges", "energy balance", "reduced basis", "chunks", "work counters"),
 }
 
 
@@ -133,8 +132,9 @@ def simulate(
     on_chunk : called with the full-rate :class:`Chunk` of each chunk of steps.
     max_memory : bytes the kept histories and buffers may use (default: half of the memory
         available now, at most 4 GiB); a larger run is refused before anything is allocated.
-    hinges : rotational springs of K whose moment follows a hysteresis law (sliders on a line;
-        ``docs/theory/nonlinear_hinges.md``).
+    hinges : rotational springs of K whose moment follows a hysteresis law
+        (``docs/theory/nonlinear_hinges.md``; in the plane: §7 of
+        ``docs/theory/planar_friction.md``).
     """
     M = chk.square("M", M, None)
     n = M.shape[0]
@@ -181,7 +181,6 @@ def simulate(
                   on_chunk=on_chunk, max_memory=max_memory)
     if planar:
         given = {"force": force, "u0": u0, "v0": v0,
-                 "hinges": hinges if hinges.nonlinear else None,
                  "method": method if method == "exact" else None}
         for name, value in given.items():
             if value is not None:
@@ -192,7 +191,7 @@ def simulate(
         chunk = min(int(chunk_steps or (1000 if progress is not None else 5000)), n_steps)
         return run_planar_scheme(M, C, K, sliders, ag=ag, influence=infl, chunk=chunk,
                                  max_events=500_000 if max_events is None else max_events,
-                                 **common)
+                                 hinges=hinges, **common)
     ag = np.zeros(n_t) if ground_accel is None else chk.series(
         "ground_accel", _one_column(ground_accel), (n_t,))
     r = np.ones(n) if influence is None else chk.series("influence", _one_column(influence),

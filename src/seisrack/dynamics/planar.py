@@ -22,6 +22,7 @@ from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics._setup import _check_memory, _kept_samples
 from seisrack.dynamics.basis import Basis
+from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import numba_available
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
 from seisrack.dynamics.run_basis import choose_basis
@@ -73,11 +74,15 @@ def run_planar_scheme(
     max_events: int,
     max_memory: float | None,
     throw: bool,
+    hinges: Hinges | None = None,
 ) -> TimeHistory:
     """Integrate the checked inputs of :func:`seisrack.dynamics.simulate` for sliders in the
     plane: ``ag`` (n_t, 2) ground accelerations along x and z with their influence vectors
     ``influence`` (n, 2) (a zero column: no load in that direction), ``av``/``rv`` the
-    vertical motion. Damping must be classical in the basis (Rayleigh or modal)."""
+    vertical motion. Damping must be classical in the basis (Rayleigh or modal). ``hinges``:
+    rotational springs of K whose moment follows a hysteresis law (§7 of the theory page)."""
+    if hinges is None:
+        hinges = no_hinges()
     n = M.shape[0]
     n_t = n_steps + 1
     loads, series = [], []
@@ -91,11 +96,13 @@ def run_planar_scheme(
     m = sliders.count
 
     pat_phys = np.column_stack(loads) if loads else np.zeros((n, 0))
-    bas = choose_basis(basis, M, K, sliders, [influence[:, c] for c in range(2)], rv=rv)
+    bas = choose_basis(basis, M, K, sliders, [influence[:, c] for c in range(2)], rv=rv,
+                       hinges=hinges)
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
     n_keep = _kept_samples(n_steps, save_every)
-    _check_memory(n_keep, chunk, nb, 4 * m, n_t, max_memory)
+    nh = hinges.count if hinges.nonlinear else 0
+    _check_memory(n_keep, chunk, nb, 4 * m + nh, n_t, max_memory)
     cq = phi.T @ (C @ phi)
     off = cq - np.diag(np.diag(cq))
     if np.max(np.abs(off), initial=0.0) > 1e-8 * max(np.max(np.abs(np.diag(cq))), 1e-300):
@@ -120,12 +127,20 @@ def run_planar_scheme(
     S = np.zeros((nb + 2, nb))  # the stuck pallets' mass and first moments (_s_update)
     A = np.zeros((nb, nb))  # the last factorised Newton matrix, kept across chunks
     fac = np.full(1, -1.0)  # its step length (-1: none)
+    Q = hinges.operator(phi)[:nh]
+    hst = hinges.initial_state()[:nh]
+    # writable: a read-only array (a compiled model's) is another numba specialisation
+    h_k, h_law, h_par, h_th0 = (chk.writable(a[:nh]) for a in
+                                (hinges.k, hinges.law, hinges.par, hinges.theta0))
+    HW = np.zeros((4, nh))
+    e_state = np.zeros(4)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
     bufs = (np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
-            np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_))
+            np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
+            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 5)))
     keep_idx = _keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     kept_N = np.empty((keep_idx.size, m))
@@ -143,14 +158,15 @@ def run_planar_scheme(
             st, ne, ns, kd_done = mod.run_planar(
                 kd, cd, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
-                _MAX_SUBSTEPS, *outs, ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:], stats)
+                _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
+                stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8])
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
             t_chunk = np.arange(start, stop + 1) * dt
             if on_chunk is not None:
                 on_chunk(Chunk(t_chunk, outs[0], outs[1], outs[2], outs[5].reshape(k, m, 2),
-                               outs[6], sliding=outs[3].reshape(k, m, 2),
+                               outs[6], hinge_moment=outs[7], sliding=outs[3].reshape(k, m, 2),
                                sliding_v=outs[4].reshape(k, m, 2)))
             sel = (keep_idx >= start) & (keep_idx <= stop)
             for dst, src in zip(kept, outs, strict=True):
@@ -176,15 +192,22 @@ def run_planar_scheme(
     n_rec = min(n_ev, max_events)
     events = [Event(float(ev_time[i]), int(ev_pallet[i]), EVENT_KINDS[int(ev_kind[i])])
               for i in range(n_rec)]
-    kq, kqd, kqdd, ku, kv, kl, ks = kept
+    kq, kqd, kqdd, ku, kv, kl, ks, khm, ken = kept
+    energy = {nm: ken[:, c].copy() for c, nm in
+              enumerate(("input", "kinetic", "strain", "damping", "friction"))}
+    if nh:
+        energy["strain"], energy["hysteresis"] = energy_split(
+            energy["strain"], kq, w2, kq @ Q.T + h_th0, khm, h_k, h_th0,
+            hinges.initial_moment()[:nh])
     return TimeHistory(
         t=keep_idx * dt, q=kq, qd=kqd, qdd=kqdd, phi=phi, slider_u=None, slider_v=None,
-        sliding=ku.reshape(-1, m, 2), sliding_v=kv.reshape(-1, m, 2),
-        friction=kl.reshape(-1, m, 2), normal=kept_N, stuck=ks,
+        sliding=ku.reshape(len(ku), m, 2), sliding_v=kv.reshape(len(kv), m, 2),
+        friction=kl.reshape(len(kl), m, 2), normal=kept_N, stuck=ks, energy=energy,
         slider_dof=sliders.dof_x.copy(), events=events, status=status_text, backend=used,
         n_substeps=n_sub, method="newmark", basis=bas.describe(), sample_index=keep_idx,
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
-                      (int(x) for x in stats), strict=True)))
+                      (int(x) for x in stats), strict=True)),
+        hinge_moment=khm, hinge_operator=Q, hinge_rotation0=h_th0)
 
 
 def _keep_index(n_steps: int, save_every: int | None) -> np.ndarray:

@@ -25,7 +25,7 @@ def choose_basis(basis: str | Basis, M, K, sliders: Sliders | PlanarSliders,  # 
     """The run's basis. ``basis``: "auto", "full", "reduced" or a Basis; ``influence``: the
     influence vector of each horizontal ground component (one on a line, x and z in the plane);
     ``rv``: the vertical one when the vertical motion loads the structure; ``F``: (n_t, n)
-    applied forces; ``hinges``: the nonlinear hinges (sliders on a line)."""
+    applied forces; ``hinges``: the nonlinear hinges (their unit moments join the loads)."""
     chosen = given_or_full_basis(basis, M, K)
     if chosen is not None:
         return chosen
@@ -34,6 +34,10 @@ def choose_basis(basis: str | Basis, M, K, sliders: Sliders | PlanarSliders,  # 
         if rv is not None:
             loads.append(M @ rv)
         n = M.shape[0]
+        if hinges is not None and hinges.nonlinear:
+            loads.append(hinges.load_vectors(n)[:, hinges.law != 0])
+            return planar_basis(M, K, sliders, np.column_stack(loads), tol=PLANAR_HINGE_RITZ_TOL,
+                                target_size=PLANAR_HINGE_RITZ_TARGET)
         return planar_basis(M, K, sliders, np.column_stack(loads) if loads else np.ones((n, 1)))
     return _line_basis(M, K, sliders, influence[0], rv, F,
                        hinges if hinges is not None and hinges.nonlinear else None)
@@ -70,6 +74,10 @@ def _line_basis(M, K, sliders: Sliders, r, rv, F, hinges) -> Basis:  # noqa: ANN
 #: benchmarks/results/rack3d.md)
 PLANAR_RITZ_TOL = 1e-1
 PLANAR_RITZ_TARGET = 40
+#: with nonlinear hinges, each hinge's unit moment is a starting load too, compressed at this
+#: tolerance (a yielding hinge needs its own directions, as on a line: HINGE_RITZ_TOL)
+PLANAR_HINGE_RITZ_TOL = HINGE_RITZ_TOL
+PLANAR_HINGE_RITZ_TARGET = 80
 
 
 def planar_basis(M, K, sliders: PlanarSliders, loads: np.ndarray,  # noqa: ANN001, N803

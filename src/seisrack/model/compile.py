@@ -118,7 +118,7 @@ def _hinges(spec: RackSpec, mesh: FrameMesh, K: sp.csr_matrix, M: sp.csr_matrix,
     and its pallets' weight, so a connector already carries its gravity moment. InputError
     when gravity alone takes a hinge past the elastic branch of its law."""
     from seisrack.dynamics._hysteresis import HYST_NPAR
-    from seisrack.model.hinge_law import HingeLaw
+    from seisrack.model.hinge_law import STIFFNESS_RTOL, HingeLaw
 
     springs, k = mesh.springs, mesh.spring_k
     base = springs[:, 1] < 0
@@ -135,6 +135,15 @@ def _hinges(spec: RackSpec, mesh: FrameMesh, K: sp.csr_matrix, M: sp.csr_matrix,
     for kk, is_base in zip(k, base, strict=True):
         law = spec.hysteresis.base if is_base else spec.hysteresis.beam_to_upright
         law = law if law is not None else HingeLaw("elastic", float(kk))
+        if law.kind != "elastic" and abs(float(kk) / law.stiffness - 1.0) > STIFFNESS_RTOL:
+            # a 3D rack's base plate bends about both axes with one law: its elastic stiffness
+            # must be that of both springs (a cross-aisle base_cross of its own has no law)
+            raise InputError(
+                "connections.base_cross", float(kk),
+                f"the stiffness of the [hysteresis.base] law ({law.stiffness:.6g} N·m/rad): "
+                "the law acts about both axes of a base plate", source=spec.source,
+                hint="Remove base_cross (the base plates are then equally stiff about both "
+                     "axes), or leave [hysteresis.base] out")
         code, par = law.pack()
         laws.append(code)
         pars.append(par)

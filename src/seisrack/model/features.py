@@ -3,7 +3,7 @@
 A 2D (plane) rack and a 3D (space) rack are the same kind of thing and take the same path; a
 capability that exists for one dimension only is listed here, and asking for it on the other
 raises an :class:`~seisrack.errors.InputError` that names the feature and the field that asked
-for it ("nonlinear connections are not built for 3D racks yet"), never a type check.
+for it ("velocity-dependent friction is not built for 3D racks yet"), never a type check.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from seisrack.errors import InputError
 
 #: feature -> the rack dimensions it is built for
 FEATURES: dict[str, tuple[int, ...]] = {
-    "nonlinear connections ([hysteresis])": (2,),
+    "nonlinear connections ([hysteresis])": (2, 3),
     "velocity-dependent friction (friction_rate)": (2,),
     "exact modal propagators (method exact)": (2,),
     "a cross-aisle ground motion component": (3,),
