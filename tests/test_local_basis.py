@@ -25,9 +25,10 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from seisrack.analysis.local_run import run_rack_local
 from seisrack.dynamics.local import LocalSliders, local_basis, measure_error
 from seisrack.dynamics.local.basis import dense
-from seisrack.dynamics.local.racks import rack_basis, rack_slices, run_rack_local
+from seisrack.dynamics.local.racks import rack_basis, rack_slices
 from seisrack.errors import InputError
 from seisrack.model import compile_rack, load_rack, with_friction
 from seisrack.motion import load_builtin_record

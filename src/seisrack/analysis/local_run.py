@@ -14,12 +14,15 @@ accelerations carry the period-2h residue of the stiff directions, see
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
+from seisrack.analysis.pallet_contacts import ContactTracker
 from seisrack.analysis.peaks import rack_operators
 from seisrack.analysis.prepare import PreparedRun, model_cache
 from seisrack.dynamics._chunk import Chunk
+from seisrack.dynamics.local.racks import rack_basis, simulate_rack
 from seisrack.dynamics.results import TimeHistory
 from seisrack.errors import InputError
 from seisrack.model.features import require_engine
@@ -58,8 +61,6 @@ def prepare_local(model: FrameModel, *, vertical: bool = False, design: bool = T
                   ) -> PreparedRun:
     """The local basis of ``model`` (its static energy error measured against the full
     model) and the rack operators projected onto it (cached per model)."""
-    from seisrack.dynamics.local.racks import rack_basis
-
     cache = model_cache(model)
     key = ("local", bool(vertical), bool(design))
     hit = cache.get(key)
@@ -127,3 +128,49 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
         events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,
         method="local", basis=hist.basis, sample_index=hist.sample_index,
         sliding_v=sq(hist.velocity), work=hist.work)
+
+
+@dataclass(frozen=True)
+class RackRun:
+    """What a rack engineer reads from a local-engine run of a compiled rack, over every
+    step: peak_sliding (m, 3) [m] down-aisle, cross-aisle (3D) and magnitude; level_peak
+    (n_level, n_dir) [m] peak mean displacement of each beam level; falls (3D racks with fall
+    limits); history: the engine's result."""
+
+    peak_sliding: np.ndarray
+    level_peak: np.ndarray
+    falls: list
+    history: object
+
+
+def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa: ANN001
+                   vertical_accel=None, **kw) -> RackRun:  # noqa: ANN001, ANN003
+    """Run a compiled rack (2D or 3D) on the local engine and track its peaks, level
+    displacements and falls over every step (``on_chunk``); keeps two samples only."""
+    is3d = model.ndm == 3
+    if basis is None:
+        basis = rack_basis(model, vertical=vertical_accel is not None)
+    levels = list(model.level_dofs)
+    ops = [np.array([basis.rows(np.asarray(d)).mean(axis=0) for d in lv]) for lv in levels]
+    m = model.n_pallets
+    peak = np.zeros((m, 3))
+    level_peak = np.zeros((len(levels[0]), len(levels)))
+    tracker = ContactTracker(model.layout, m) if is3d and model.layout is not None else None
+
+    def on_chunk(ch) -> None:  # noqa: ANN001
+        u = ch.sliding
+        np.maximum(peak[:, 0], np.abs(u[:, :, 0]).max(axis=0), out=peak[:, 0])
+        if u.shape[2] > 1:
+            np.maximum(peak[:, 1], np.abs(u[:, :, 1]).max(axis=0), out=peak[:, 1])
+        np.maximum(peak[:, 2], np.sqrt((u**2).sum(axis=2)).max(axis=0), out=peak[:, 2])
+        for c, op in enumerate(ops):
+            np.maximum(level_peak[:, c], np.abs(ch.q @ op.T).max(axis=0),
+                       out=level_peak[:, c])
+        if tracker is not None:
+            tracker.update(ch.t, ch.sliding, ch.velocity)
+
+    kw.setdefault("save_every", None)
+    hist = simulate_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
+                         on_chunk=on_chunk, keep_coordinates=True, **kw)
+    return RackRun(peak_sliding=peak, level_peak=level_peak,
+                   falls=tracker.falls() if tracker is not None else [], history=hist)

@@ -16,7 +16,6 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from seisrack.analysis.response import ACCEL_FILTER_ORDER
 from seisrack.dynamics.engine import Chunk
 
 
@@ -421,6 +420,10 @@ def design_summary(resp) -> dict | None:  # noqa: ANN001
         "at_max_abs_M": [[float(n), float(m)] for n, m in at_m.T],
     }
     return out
+
+
+#: order of the Butterworth low-pass, applied forward and backward (zero phase)
+ACCEL_FILTER_ORDER = 4
 
 
 def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER) -> np.ndarray:

@@ -22,6 +22,7 @@ import numpy as np
 from seisrack.analysis.hinges import HingePeaks, hinge_response
 from seisrack.analysis.pallet_contacts import ContactTracker
 from seisrack.analysis.peaks import (  # noqa: F401  (lowpass re-exported)
+    ACCEL_FILTER_ORDER,
     PeakTracker,
     connection_moment,
     level_sum,
@@ -31,7 +32,6 @@ from seisrack.analysis.peaks import (  # noqa: F401  (lowpass re-exported)
 from seisrack.analysis.prepare import RIGID_MU, PreparedRun, prepare_run, rack_sliders
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
-    ACCEL_FILTER_ORDER,
     SLIDING_TOL_M,
     RackResponse,
 )

@@ -24,8 +24,6 @@ SLIDING_TOL_M = 1e-6
 #: (0.5-10 Hz), below the pallets' local axial beam modes (100-130 Hz) and below the Nyquist
 #: frequency of records sampled at 50 Hz
 ACCEL_FILTER_HZ = 20.0
-#: order of the Butterworth low-pass, applied forward and backward (zero phase)
-ACCEL_FILTER_ORDER = 4
 #: the histories that have a direction (a trailing axis on a 3D rack)
 DIRECTIONAL = ("ground_accel", "beam_displacement", "beam_acceleration", "beam_acceleration_raw",
                "beam_acceleration_filtered", "contact_force", "base_shear",

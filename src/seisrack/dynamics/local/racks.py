@@ -6,8 +6,6 @@ load on every beam level, per side and direction)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -128,51 +126,3 @@ def simulate_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None, 
                           influence=infl, vertical_accel=vertical_accel,
                           vertical_influence=None if vertical_accel is None else model.r_y,
                           g=model.g, basis=basis, **kw)
-
-
-@dataclass(frozen=True)
-class RackRun:
-    """What a rack engineer reads from a local-engine run of a compiled rack, over every
-    step: peak_sliding (m, 3) [m] down-aisle, cross-aisle (3D) and magnitude; level_peak
-    (n_level, n_dir) [m] peak mean displacement of each beam level; falls (3D racks with fall
-    limits); history: the engine's result."""
-
-    peak_sliding: np.ndarray
-    level_peak: np.ndarray
-    falls: list
-    history: object
-
-
-def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa: ANN001
-                   vertical_accel=None, **kw) -> RackRun:  # noqa: ANN001, ANN003
-    """Run a compiled rack (2D or 3D) on the local engine and track its peaks, level
-    displacements and falls over every step (``on_chunk``); keeps two samples only."""
-    from seisrack.analysis.pallet_contacts import ContactTracker
-
-    is3d = model.ndm == 3
-    if basis is None:
-        basis = rack_basis(model, vertical=vertical_accel is not None)
-    levels = list(model.level_dofs)
-    ops = [np.array([basis.rows(np.asarray(d)).mean(axis=0) for d in lv]) for lv in levels]
-    m = model.n_pallets
-    peak = np.zeros((m, 3))
-    level_peak = np.zeros((len(levels[0]), len(levels)))
-    tracker = ContactTracker(model.layout, m) if is3d and model.layout is not None else None
-
-    def on_chunk(ch) -> None:  # noqa: ANN001
-        u = ch.sliding
-        np.maximum(peak[:, 0], np.abs(u[:, :, 0]).max(axis=0), out=peak[:, 0])
-        if u.shape[2] > 1:
-            np.maximum(peak[:, 1], np.abs(u[:, :, 1]).max(axis=0), out=peak[:, 1])
-        np.maximum(peak[:, 2], np.sqrt((u**2).sum(axis=2)).max(axis=0), out=peak[:, 2])
-        for c, op in enumerate(ops):
-            np.maximum(level_peak[:, c], np.abs(ch.q @ op.T).max(axis=0),
-                       out=level_peak[:, c])
-        if tracker is not None:
-            tracker.update(ch.t, ch.sliding, ch.velocity)
-
-    kw.setdefault("save_every", None)
-    hist = simulate_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
-                         on_chunk=on_chunk, keep_coordinates=True, **kw)
-    return RackRun(peak_sliding=peak, level_peak=level_peak,
-                   falls=tracker.falls() if tracker is not None else [], history=hist)
