@@ -24,37 +24,7 @@ from seisrack.analysis.prepare import PreparedRun, model_cache
 from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics.local.racks import rack_basis, simulate_rack
 from seisrack.dynamics.results import TimeHistory
-from seisrack.errors import InputError
-from seisrack.model.features import require_engine
 from seisrack.model.frame_model import FrameModel
-
-#: the engines of :func:`seisrack.analysis.run_rack`
-ENGINES = ("default", "local")
-
-
-def check_engine(engine: str, model: FrameModel, *, method: str = "auto",
-                 basis: object = "auto", cli: bool = False) -> None:
-    """Refuse, by name, what ``engine`` does not do for ``model`` (``cli``: name the
-    command's options)."""
-    opt = "--" if cli else ""
-    if engine not in ENGINES:
-        raise InputError(f"{opt}engine", engine, " or ".join(f'"{e}"' for e in ENGINES))
-    if engine == "default":
-        return
-    if model.nonlinear_hinges:
-        require_engine("nonlinear connections ([hysteresis])", engine, "hysteresis",
-                       "a nonlinear law")
-    rates = np.flatnonzero(np.asarray(model.pallet_friction_rate) != 0)
-    if rates.size:
-        j = int(rates[0])
-        require_engine("velocity-dependent friction (friction_rate)", engine,
-                       f"friction_rate of pallet {j + 1}", float(model.pallet_friction_rate[j]))
-    if method != "auto":
-        require_engine("a choice of time integration (method)", engine, f"{opt}method",
-                       method)
-    if not (isinstance(basis, str) and basis == "auto"):
-        require_engine("a choice of structure basis (basis)", engine, f"{opt}basis",
-                       basis if isinstance(basis, str) else type(basis).__name__)
 
 
 def prepare_local(model: FrameModel, *, vertical: bool = False, design: bool = True

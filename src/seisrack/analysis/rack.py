@@ -39,7 +39,7 @@ from seisrack.dynamics import Sliders, TimeHistory, simulate
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.engine import single_blas_thread
 from seisrack.errors import InputError, SolverError
-from seisrack.model.features import require
+from seisrack.model.features import check_engine, require
 from seisrack.model.frame_model import FrameModel
 from seisrack.motion.components import (  # noqa: F401  (DEFAULT_MAX_DT re-exported)
     DEFAULT_MAX_DT,
@@ -133,12 +133,10 @@ def run_rack(
     if not (isinstance(free_vibration, int | float) and math.isfinite(free_vibration)
             and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
-    from seisrack.analysis.local_run import check_engine
-
-    check_engine(engine, model, method=method, basis=basis)
     mot = ground_motion(model, motion, vertical)
     if method == "exact":
         require("exact modal propagators (method exact)", model.ndm, "method", method)
+    check_engine(engine, model, method=method, basis=basis)
     k = analysis_grid(mot, dt)
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))

@@ -158,11 +158,10 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from seisrack.analysis import analysis_grid, run_rack
-    from seisrack.analysis.local_run import check_engine
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
     from seisrack.model import compile_rack, load_rack, with_friction
-    from seisrack.model.features import require
+    from seisrack.model.features import check_engine, require
 
     _check_options(args)
     spec = load_rack(args.rack)

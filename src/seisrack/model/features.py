@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from seisrack.errors import InputError
 
 #: feature -> the rack dimensions it is built for
@@ -90,3 +92,32 @@ def _check_sections_3d(spec: Any) -> None:
                 raise InputError(f"sections.{name}.{key}", None, f"a value > 0 [m⁴] ({what})",
                                  source=spec.source, hint="A 3D rack needs I (or Iz), Iy and J "
                                  "for every beam and upright section")
+
+
+#: the engines of :func:`seisrack.analysis.run_rack`
+ENGINES = ("default", "local")
+
+
+def check_engine(engine: str, model: Any, *, method: str = "auto",
+                 basis: object = "auto", cli: bool = False) -> None:
+    """Refuse, by name, what ``engine`` does not do for ``model`` (``cli``: name the
+    command's options)."""
+    opt = "--" if cli else ""
+    if engine not in ENGINES:
+        raise InputError(f"{opt}engine", engine, " or ".join(f'"{e}"' for e in ENGINES))
+    if engine == "default":
+        return
+    if model.nonlinear_hinges:
+        require_engine("nonlinear connections ([hysteresis])", engine, "hysteresis",
+                       "a nonlinear law")
+    rates = np.flatnonzero(np.asarray(model.pallet_friction_rate) != 0)
+    if rates.size:
+        j = int(rates[0])
+        require_engine("velocity-dependent friction (friction_rate)", engine,
+                       f"friction_rate of pallet {j + 1}", float(model.pallet_friction_rate[j]))
+    if method != "auto":
+        require_engine("a choice of time integration (method)", engine, f"{opt}method",
+                       method)
+    if not (isinstance(basis, str) and basis == "auto"):
+        require_engine("a choice of structure basis (basis)", engine, f"{opt}basis",
+                       basis if isinstance(basis, str) else type(basis).__name__)
