@@ -42,3 +42,19 @@ def get_kernel(backend: str = "auto", method: str = "newmark") -> ModuleType:
             )
         return importlib.import_module("seisrack.dynamics._kernel_numba")
     raise InputError("backend", backend, '"auto", "numba" or "python"')
+
+
+def scheme_kernel(backend: str, numba_module: str, python_module: str
+                  ) -> tuple[ModuleType, str]:
+    """(module, backend used) of a scheme whose numba build and pure-Python twin are the
+    modules ``numba_module`` and ``python_module`` (dotted names); ``backend`` as for
+    :func:`get_kernel`."""
+    if backend == "auto":
+        backend = "numba" if numba_available() else "python"
+    if backend == "numba":
+        if not numba_available():
+            raise InputError("backend", backend, '"python" (numba is not installed)')
+        return importlib.import_module(numba_module), backend
+    if backend == "python":
+        return importlib.import_module(python_module), backend
+    raise InputError("backend", backend, '"auto", "numba" or "python"')

@@ -23,7 +23,7 @@ from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics._setup import _check_memory, _kept_samples
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
-from seisrack.dynamics.kernels import numba_available
+from seisrack.dynamics.kernels import scheme_kernel
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
 from seisrack.dynamics.run_basis import choose_basis
 from seisrack.dynamics.sliders import PlanarSliders
@@ -43,17 +43,8 @@ _STATUS = {
 
 
 def _kernel(backend: str):  # noqa: ANN202
-    if backend == "auto":
-        backend = "numba" if numba_available() else "python"
-    if backend == "numba":
-        if not numba_available():
-            raise InputError("backend", backend, '"python" (numba is not installed)')
-        from seisrack.dynamics import _planar_numba as mod
-    elif backend == "python":
-        from seisrack.dynamics import _kernel_planar as mod
-    else:
-        raise InputError("backend", backend, '"auto", "numba" or "python"')
-    return mod, backend
+    return scheme_kernel(backend, "seisrack.dynamics._planar_numba",
+                         "seisrack.dynamics._kernel_planar")
 
 
 def run_planar_scheme(

@@ -119,28 +119,7 @@ class PlanarSliders:
         for name, a in (("dof_x", dx), ("dof_z", dz)):
             if a.size and not np.all(np.equal(np.mod(a, 1), 0)):
                 raise InputError(f"sliders.{name}", a.tolist(), "integer DOF indices")
-        m = dx.shape[0]
-
-        def _arr(name: str, val) -> np.ndarray:  # noqa: ANN001
-            a = np.asarray(val, dtype=float)
-            if a.ndim == 0:
-                a = np.full(m, float(a))
-            if a.shape != (m,) or not np.all(np.isfinite(a)):
-                raise InputError(f"sliders.{name}", val, f"a finite scalar or {m} values")
-            return a
-
-        mass_a = _arr("mass", mass)
-        mus = _arr("mu_static", mu_static)
-        mud = mus.copy() if mu_dynamic is None else _arr("mu_dynamic", mu_dynamic)
-        if np.any(mass_a <= 0):
-            raise InputError("sliders.mass", mass_a.tolist(), "masses > 0 kg")
-        if np.any(mus < 0) or np.any(mud < 0):
-            raise InputError("sliders.mu", [mus.tolist(), mud.tolist()],
-                             "friction coefficients >= 0")
-        if np.any(mud > mus):
-            j = int(np.argmax(mud > mus))
-            raise InputError(f"sliders.mu_dynamic[{j}]", float(mud[j]),
-                             f"a value <= mu_static ({mus[j]:g})")
+        mass_a, mus, mud = mass_and_friction(dx.shape[0], mass, mu_static, mu_dynamic)
         object.__setattr__(self, "dof_x", dx.astype(np.int64))
         object.__setattr__(self, "dof_z", dz.astype(np.int64))
         object.__setattr__(self, "mass", mass_a)
@@ -167,3 +146,32 @@ class PlanarSliders:
                 on = dofs[:, s] >= 0
                 P[2 * np.flatnonzero(on) + c] += phi[dofs[on, s], :] / k
         return P
+
+
+def mass_and_friction(m: int, mass, mu_static, mu_dynamic=None  # noqa: ANN001
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(m,) masses [kg], static and dynamic friction coefficients of ``m`` sliders, each given
+    as a scalar or ``m`` values (``mu_dynamic`` None: equal to ``mu_static``); InputError on a
+    non-finite value, a mass <= 0, a negative coefficient or mu_dynamic > mu_static."""
+
+    def arr(name: str, val) -> np.ndarray:  # noqa: ANN001
+        a = np.asarray(val, dtype=float)
+        if a.ndim == 0:
+            a = np.full(m, float(a))
+        if a.shape != (m,) or not np.all(np.isfinite(a)):
+            raise InputError(f"sliders.{name}", val, f"a finite scalar or {m} values")
+        return a
+
+    mass_a = arr("mass", mass)
+    mus = arr("mu_static", mu_static)
+    mud = mus.copy() if mu_dynamic is None else arr("mu_dynamic", mu_dynamic)
+    if np.any(mass_a <= 0):
+        raise InputError("sliders.mass", mass_a.tolist(), "masses > 0 kg")
+    if np.any(mus < 0) or np.any(mud < 0):
+        raise InputError("sliders.mu", [mus.tolist(), mud.tolist()],
+                         "friction coefficients >= 0")
+    if np.any(mud > mus):
+        j = int(np.argmax(mud > mus))
+        raise InputError(f"sliders.mu_dynamic[{j}]", float(mud[j]),
+                         f"a value <= mu_static ({mus[j]:g})")
+    return mass_a, mus, mud

@@ -16,7 +16,7 @@ import numpy as np
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import blas_controller
 from seisrack.dynamics._setup import DEFAULT_MAX_MEMORY
-from seisrack.dynamics.kernels import numba_available
+from seisrack.dynamics.kernels import scheme_kernel
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
     DEFAULT_TOL,
@@ -42,17 +42,8 @@ _STATUS = {
 
 
 def _kernel(backend: str):  # noqa: ANN202
-    if backend == "auto":
-        backend = "numba" if numba_available() else "python"
-    if backend == "numba":
-        if not numba_available():
-            raise InputError("backend", backend, '"python" (numba is not installed)')
-        from seisrack.dynamics.local import _numba as mod
-    elif backend == "python":
-        from seisrack.dynamics.local import _kernel as mod
-    else:
-        raise InputError("backend", backend, '"auto", "numba" or "python"')
-    return mod, backend
+    return scheme_kernel(backend, "seisrack.dynamics.local._numba",
+                         "seisrack.dynamics.local._kernel")
 
 
 def support_rows(b: LocalBasis, sliders: LocalSliders) -> tuple[np.ndarray, np.ndarray]:

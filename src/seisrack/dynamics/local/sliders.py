@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from seisrack.dynamics.sliders import mass_and_friction
 from seisrack.errors import InputError
 
 
@@ -34,28 +35,7 @@ class LocalSliders:
                              "(pallets, supports, directions) with 1 or 2 directions")
         if sup.size and not np.all(np.equal(np.mod(sup, 1), 0)):
             raise InputError("sliders.support", "non-integer entries", "integer DOF indices")
-        m = sup.shape[0]
-
-        def _arr(name: str, val) -> np.ndarray:  # noqa: ANN001
-            a = np.asarray(val, dtype=float)
-            if a.ndim == 0:
-                a = np.full(m, float(a))
-            if a.shape != (m,) or not np.all(np.isfinite(a)):
-                raise InputError(f"sliders.{name}", val, f"a finite scalar or {m} values")
-            return a
-
-        mass_a = _arr("mass", mass)
-        mus = _arr("mu_static", mu_static)
-        mud = mus.copy() if mu_dynamic is None else _arr("mu_dynamic", mu_dynamic)
-        if np.any(mass_a <= 0):
-            raise InputError("sliders.mass", mass_a.tolist(), "masses > 0 kg")
-        if np.any(mus < 0) or np.any(mud < 0):
-            raise InputError("sliders.mu", [mus.tolist(), mud.tolist()],
-                             "friction coefficients >= 0")
-        if np.any(mud > mus):
-            j = int(np.argmax(mud > mus))
-            raise InputError(f"sliders.mu_dynamic[{j}]", float(mud[j]),
-                             f"a value <= mu_static ({mus[j]:g})")
+        mass_a, mus, mud = mass_and_friction(sup.shape[0], mass, mu_static, mu_dynamic)
         object.__setattr__(self, "support", sup.astype(np.int64))
         object.__setattr__(self, "mass", mass_a)
         object.__setattr__(self, "mu_static", mus)
