@@ -48,19 +48,27 @@ def _kept_samples(n_steps: int, save_every: int | None) -> int:
     return n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
 
 
+def memory_budget(max_memory: float | None) -> float | None:
+    """Bytes one run may take: ``max_memory`` if given, else half of the memory free now and
+    at most :data:`DEFAULT_MAX_MEMORY` (studies run several at once; ask for more with
+    ``max_memory=``); None where the free memory cannot be read."""
+    if max_memory is not None:
+        return max_memory
+    try:
+        avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return None
+    return min(0.5 * avail, DEFAULT_MAX_MEMORY)
+
+
 def _check_memory(n_keep: int, chunk: int, nb: int, m: int, n_t: int,
                   max_memory: float | None) -> None:
     """Refuse a run whose histories and buffers would not fit, before allocating them."""
     per_row = 8 * (3 * nb + 4 * m + 5) + m
     need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
-    if max_memory is None:
-        try:
-            avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-        except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-            return
-        # a single run never takes more than half of what is free, nor more than
-        # DEFAULT_MAX_MEMORY: studies run several at once (ask for more with max_memory=)
-        max_memory = min(0.5 * avail, DEFAULT_MAX_MEMORY)
+    max_memory = memory_budget(max_memory)
+    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
+        return
     if need > max_memory:
         raise InputError(
             "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "

@@ -8,14 +8,13 @@ and refuse a run too large before allocating, then integrate in chunks.
 from __future__ import annotations
 
 import logging
-import os
 from collections.abc import Callable
 
 import numpy as np
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import blas_controller
-from seisrack.dynamics._setup import DEFAULT_MAX_MEMORY
+from seisrack.dynamics._setup import memory_budget
 from seisrack.dynamics.kernels import scheme_kernel
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
@@ -302,12 +301,9 @@ def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis)
 def _check_memory(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis,
                   max_memory: float | None) -> None:
     need = memory_estimate(n_keep, chunk, nq, m, basis)
-    if max_memory is None:
-        try:
-            avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-        except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-            return
-        max_memory = min(0.5 * avail, DEFAULT_MAX_MEMORY)
+    max_memory = memory_budget(max_memory)
+    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
+        return
     if need > max_memory:
         raise InputError(
             "n_steps", f"{n_keep} kept samples of {nq} coordinates and {m} pallets "
