@@ -24,7 +24,7 @@ from seisrack.dynamics._setup import _check_memory, _kept_samples
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import scheme_kernel
-from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
+from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event, TimeHistory
 from seisrack.dynamics.run_basis import choose_basis
 from seisrack.dynamics.sliders import PlanarSliders
 from seisrack.errors import InputError, SolverError
@@ -33,11 +33,8 @@ _LOG = logging.getLogger(__name__)
 
 _MAX_SUBSTEPS = 512
 _STATUS = {
-    0: "ok",
-    1: "event buffer overflow (increase max_events)",
+    **STEP_STATUS,
     2: "too many events inside one step (reduce dt)",
-    3: "non-finite response (check the input)",
-    4: "the step matrix is not positive definite (check M, K, C)",
     5: "the sliding directions did not converge inside a step (reduce dt)",
 }
 

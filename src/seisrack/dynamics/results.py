@@ -8,6 +8,13 @@ from functools import cached_property
 import numpy as np
 
 EVENT_KINDS = ("slip", "stick", "reverse")
+#: status codes that the planar and local kernels share (each adds its own)
+STEP_STATUS = {
+    0: "ok",
+    1: "event buffer overflow (increase max_events)",
+    3: "non-finite response (check the input)",
+    4: "the step matrix is not positive definite (check M, K, C)",
+}
 
 
 @dataclass(frozen=True)

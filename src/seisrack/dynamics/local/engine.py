@@ -25,19 +25,13 @@ from seisrack.dynamics.local.basis import (
 )
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory
 from seisrack.dynamics.local.sliders import LocalSliders
-from seisrack.dynamics.results import EVENT_KINDS, Event
+from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event
 from seisrack.errors import InputError, SolverError
 
 _LOG = logging.getLogger(__name__)
 
 DEFAULT_CHUNK = 2000
-_STATUS = {
-    0: "ok",
-    1: "event buffer overflow (increase max_events)",
-    2: "the step's Newton iteration did not converge (reduce dt)",
-    3: "non-finite response (check the input)",
-    4: "the step matrix is not positive definite (check M, K, C)",
-}
+_STATUS = {**STEP_STATUS, 2: "the step's Newton iteration did not converge (reduce dt)"}
 
 
 def _kernel(backend: str):  # noqa: ANN202
