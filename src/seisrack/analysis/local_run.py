@@ -52,7 +52,8 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
     ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
     ``mu`` replaces every friction coefficient (the rigid companion)."""
     from seisrack.dynamics.local import LocalSliders
-    from seisrack.dynamics.local.engine import _keep_index, simulate_local
+    from seisrack.dynamics.local.engine import simulate_local
+    from seisrack.dynamics.run_basis import keep_index
 
     b = prepared.basis
     nd = model.n_dir
@@ -61,7 +62,7 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
                            model.pallet_mu_static if mu is None else mu,
                            model.pallet_mu_dynamic if mu is None else mu)
     n_steps = ag.shape[0] - 1
-    keep = _keep_index(n_steps, save_every)
+    keep = keep_index(n_steps, save_every)
     qdd = np.zeros((keep.size, b.size))
     state: dict = {"v_prev": None}
     sq = (lambda a: a[..., 0]) if line else (lambda a: a)  # noqa: E731

@@ -1,10 +1,15 @@
-"""Validation of the engine's array inputs (dense or scipy sparse), at the boundary."""
+"""Validation of the engine's inputs (arrays dense or scipy sparse), at the boundary:
+:func:`run_inputs` checks every argument of :func:`seisrack.dynamics.simulate` in one place."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
+from seisrack.dynamics.hinges import Hinges, no_hinges
+from seisrack.dynamics.sliders import PlanarSliders, Sliders
 from seisrack.errors import InputError
 
 
@@ -56,8 +61,137 @@ def positive_int(name: str, value: object) -> int:
     return int(value)
 
 
-def writable(a: np.ndarray) -> np.ndarray:
-    """A C-contiguous, writable float array: numba compiles a separate specialisation for
-    read-only arrays (a compiled model's arrays are locked), so the kernel always gets these."""
-    a = np.ascontiguousarray(a)
-    return a if a.flags.writeable else a.copy()
+#: steps integrated per kernel call (bounded working memory; the state carries over exactly)
+DEFAULT_CHUNK = 20_000
+#: what the planar scheme does not support (argument -> what it is)
+PLANAR_UNSUPPORTED = {
+    "force": "applied forces",
+    "u0": "an initial displacement",
+    "v0": "an initial velocity",
+    "method": "the exact modal propagators",
+}
+
+
+@dataclass(frozen=True)
+class RunInputs:
+    """The checked arguments of :func:`seisrack.dynamics.simulate`, in the shapes its schemes
+    take: ``ag`` (n_t,) along the line or (n_t, 2) along x and z in the plane, ``influence``
+    the matching (n,) or (n, 2), ``chunk`` the steps per kernel call."""
+
+    M: object
+    C: object
+    K: object
+    planar: bool
+    dt: float
+    g: float
+    n_steps: int
+    ag: np.ndarray
+    influence: np.ndarray
+    av: np.ndarray | None
+    rv: np.ndarray | None
+    F: np.ndarray | None
+    u0: np.ndarray | None
+    v0: np.ndarray | None
+    chunk: int
+    save_every: int | None
+    hinges: Hinges
+
+    @property
+    def influences(self) -> list[np.ndarray]:
+        """The influence vector of each horizontal ground component."""
+        r = self.influence
+        return [r[:, c] for c in range(r.shape[1])] if r.ndim == 2 else [r]
+
+
+def run_inputs(M, C, K, sliders, *, dt, n_steps, ground_accel, influence, force,  # noqa: ANN001, C901, N803
+               vertical_accel, vertical_influence, g, u0, v0, chunk_steps, save_every, method,
+               hinges, progress) -> RunInputs:
+    """Every argument of :func:`seisrack.dynamics.simulate` checked, in one place (see there
+    for their meaning); bad input raises :class:`InputError` naming the argument."""
+    M = square("M", M, None)
+    n = M.shape[0]
+    C = square("C", C, n)
+    K = square("K", K, n)
+    check_symmetric("M", M)
+    check_symmetric("K", K)
+    planar = isinstance(sliders, PlanarSliders)
+    if not (planar or isinstance(sliders, Sliders)):
+        raise InputError("sliders", type(sliders).__name__,
+                         "seisrack.dynamics.Sliders or seisrack.dynamics.PlanarSliders")
+    if not (isinstance(dt, int | float) and np.isfinite(dt) and dt > 0):
+        raise InputError("dt", dt, "a finite time step > 0 s")
+    if not (np.isfinite(g) and g > 0):
+        raise InputError("g", g, "a finite gravity > 0 m/s²")
+    sliders.check_dofs(n)
+    lengths = [np.shape(x)[0] for x in (ground_accel, force, vertical_accel)
+               if x is not None and np.ndim(x) >= 1]
+    if n_steps is None:
+        if not lengths:
+            raise InputError("n_steps", None, "a number of steps when no excitation is given")
+        n_steps = lengths[0] - 1
+    if isinstance(n_steps, bool) or int(n_steps) != n_steps or n_steps < 1:
+        raise InputError("n_steps", n_steps, "an integer >= 1")
+    n_steps = int(n_steps)
+    n_t = n_steps + 1
+    av = None if vertical_accel is None else series("vertical_accel", vertical_accel, (n_t,))
+    rv = None
+    if av is not None and vertical_influence is not None:
+        rv = series("vertical_influence", vertical_influence, (n,))
+    if chunk_steps is not None:
+        positive_int("chunk_steps", chunk_steps)
+    if save_every is not None:
+        save_every = positive_int("save_every", save_every)
+    if method not in ("auto", "exact", "newmark"):
+        raise InputError("method", method, '"auto", "exact" or "newmark"')
+    if hinges is None:
+        hinges = no_hinges()
+    if not isinstance(hinges, Hinges):
+        raise InputError("hinges", type(hinges).__name__, "a seisrack.dynamics.hinges.Hinges")
+    hinges.check(n)
+    if planar:
+        given = {"force": force, "u0": u0, "v0": v0,
+                 "method": method if method == "exact" else None}
+        for name, value in given.items():
+            if value is not None:
+                raise InputError(name, value if name == "method" else "given",
+                                 f"not given for sliders in the plane: the planar scheme has "
+                                 f"no {PLANAR_UNSUPPORTED[name]}")
+        ag, r = _planar_ground(ground_accel, influence, n, n_t)
+        F = q_u0 = q_v0 = None
+        chunk = int(chunk_steps or (1000 if progress is not None else 5000))
+    else:
+        ag = np.zeros(n_t) if ground_accel is None else series(
+            "ground_accel", _one_column(ground_accel), (n_t,))
+        r = np.ones(n) if influence is None else series("influence", _one_column(influence),
+                                                        (n,))
+        F = None if force is None else series("force", force, (n_t, n))
+        q_u0 = np.zeros(n) if u0 is None else series("u0", u0, (n,))
+        q_v0 = np.zeros(n) if v0 is None else series("v0", v0, (n,))
+        chunk = int(chunk_steps or (2000 if progress is not None else DEFAULT_CHUNK))
+    return RunInputs(M=M, C=C, K=K, planar=planar, dt=float(dt), g=float(g), n_steps=n_steps,
+                     ag=ag, influence=r, av=av, rv=rv, F=F, u0=q_u0, v0=q_v0,
+                     chunk=min(chunk, n_steps), save_every=save_every, hinges=hinges)
+
+
+def _one_column(a):  # noqa: ANN001, ANN202
+    """A (k, 1) array as (k,): sliders on a line take one ground component."""
+    a = np.asarray(a)
+    return a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
+
+
+def _planar_ground(ground_accel, influence, n: int, n_t: int  # noqa: ANN001
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(n_t, 2) ground accelerations x, z and (n, 2) influence vectors of planar sliders."""
+    if ground_accel is None:
+        return np.zeros((n_t, 2)), np.zeros((n, 2))
+    a = np.asarray(ground_accel, dtype=float)
+    if a.ndim == 1:
+        a = np.column_stack([a, np.zeros_like(a)])
+    a = series("ground_accel", a, (n_t, 2))
+    if influence is None:
+        raise InputError("influence", None, "(n, 2) influence vectors of the x and z ground "
+                         "components for sliders in the plane")
+    r = np.asarray(influence, dtype=float)
+    if r.ndim == 1:
+        r = np.column_stack([r, np.zeros_like(r)])
+    return a, series("influence", r, (n, 2))

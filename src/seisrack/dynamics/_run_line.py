@@ -11,14 +11,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
-from seisrack.dynamics._setup import (
+from seisrack.dynamics._line_setup import (
     _check_friction_rate,
-    _check_memory,
     _exact_unsupported,
-    _kept_samples,
     _load_patterns,
     _stiffness_proportional,
 )
@@ -26,9 +23,9 @@ from seisrack.dynamics._store import Buffers as _Buffers
 from seisrack.dynamics._store import Kept as _Kept
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split
-from seisrack.dynamics.kernels import get_kernel
+from seisrack.dynamics.kernels import get_kernel, writable
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
-from seisrack.dynamics.run_basis import choose_basis
+from seisrack.dynamics.run_basis import kept_samples
 from seisrack.dynamics.sliders import Sliders
 from seisrack.errors import InputError, SolverError
 
@@ -53,18 +50,16 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
              rv: np.ndarray | None, g: float, q_u0: np.ndarray, q_v0: np.ndarray,
              backend: str, track_energy: bool, max_events: int, throw: bool,
              progress: Callable[[int], None] | None, chunk: int, method: str,
-             basis: str | Basis, save_every: int | None,
-             on_chunk: Callable[[Chunk], None] | None, max_memory: float | None,
-             hinges: Hinges) -> TimeHistory:
+             basis: Basis, save_every: int | None,
+             on_chunk: Callable[[Chunk], None] | None, hinges: Hinges) -> TimeHistory:
     """Integrate the checked inputs of :func:`seisrack.dynamics.simulate` (see there)."""
     n_t = n_steps + 1
     m = sliders.count
     nonlinear = hinges.nonlinear or sliders.velocity_dependent
-    bas = choose_basis(basis, M, K, sliders, [r], rv=rv, F=F, hinges=hinges)
+    bas = basis
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
-    n_keep = _kept_samples(n_steps, save_every)
-    _check_memory(n_keep, chunk, nb, m + hinges.count, n_t, max_memory)
+    n_keep = kept_samples(n_steps, save_every)
 
     cq = phi.T @ (C @ phi)
     off = cq - np.diag(np.diag(cq))
@@ -90,19 +85,19 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
     use_exact = method != "newmark" and not why_not
     kern = get_kernel(backend, "exact" if use_exact else "newmark")
     used = "numba" if kern.__name__.endswith("_numba") else "python"
-    mass = chk.writable(sliders.mass)
-    mus = chk.writable(sliders.mu_static)
-    mud = chk.writable(sliders.mu_dynamic)
-    P = chk.writable(P)
-    w2c = chk.writable(w2)
-    ag = chk.writable(ag)
-    pat = chk.writable(pat)
+    mass = writable(sliders.mass)
+    mus = writable(sliders.mu_static)
+    mud = writable(sliders.mu_dynamic)
+    P = writable(P)
+    w2c = writable(w2)
+    ag = writable(ag)
+    pat = writable(pat)
 
     nh = hinges.count if hinges.nonlinear else 0
     Q = hinges.operator(phi)[:nh]
     hst = hinges.initial_state()[:nh]
     # writable: a read-only array (a compiled model's) is another numba specialisation
-    h_k, h_law, h_par, h_th0 = (chk.writable(a[:nh]) for a in
+    h_k, h_law, h_par, h_th0 = (writable(a[:nh]) for a in
                                 (hinges.k, hinges.law, hinges.par, hinges.theta0))
     rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
     buf = _Buffers(chunk + 1, nb, m, nh)

@@ -1,5 +1,5 @@
-"""The stick–slip engine's one entry point, :func:`simulate`: check the inputs, then run the scheme
-the sliders call for.
+"""The stick–slip engine's one entry point, :func:`simulate`: check the inputs, choose the basis
+and check the memory once, then run the scheme the sliders call for.
 
 The structure is linear (M, C, K; dense or scipy sparse, plus optional hysteretic hinges); the
 sliders are masses resting on structural DOFs with Coulomb friction (paper §II–III). Two schemes
@@ -26,29 +26,23 @@ import numpy as np
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import single_blas_thread  # noqa: F401  (re-exported)
 from seisrack.dynamics._chunk import Chunk  # noqa: F401  (re-exported: on_chunk's argument)
+from seisrack.dynamics._inputs import DEFAULT_CHUNK  # noqa: F401  (re-exported)
 from seisrack.dynamics._run_line import run_line
-from seisrack.dynamics._setup import (  # noqa: F401  (constants re-exported: the engine's API)
+from seisrack.dynamics.basis import Basis, full_basis
+from seisrack.dynamics.hinges import Hinges
+from seisrack.dynamics.planar import run_planar_scheme
+from seisrack.dynamics.results import TimeHistory
+from seisrack.dynamics.run_basis import (  # noqa: F401  (constants re-exported: the engine's API)
     AUTO_FULL_MAX_DOF,
     DEFAULT_MAX_MEMORY,
     HINGE_RITZ_BLOCKS,
     HINGE_RITZ_TOL,
+    check_memory,
+    choose_basis,
+    kept_samples,
 )
-from seisrack.dynamics.basis import Basis, full_basis
-from seisrack.dynamics.hinges import Hinges, no_hinges
-from seisrack.dynamics.planar import run_planar_scheme
-from seisrack.dynamics.results import TimeHistory
 from seisrack.dynamics.sliders import PlanarSliders, Sliders
-from seisrack.errors import InputError
 
-#: steps integrated per kernel call (bounded working memory; the state carries over exactly)
-DEFAULT_CHUNK = 20_000
-#: what the planar scheme does not support (argument -> what it is)
-_PLANAR_UNSUPPORTED = {
-    "force": "applied forces",
-    "u0": "an initial displacement",
-    "v0": "an initial velocity",
-    "method": "the exact modal propagators",
-}
 #: what each scheme supports beyond the ground motion, for the documentation and the refusals
 SCHEME_FEATURES = {
     "line": ("ground motion", "vertical motion", "applied forces", "initial state",
@@ -136,95 +130,26 @@ def simulate(
         (``docs/theory/nonlinear_hinges.md``; in the plane: §7 of
         ``docs/theory/planar_friction.md``).
     """
-    M = chk.square("M", M, None)
-    n = M.shape[0]
-    C = chk.square("C", C, n)
-    K = chk.square("K", K, n)
-    chk.check_symmetric("M", M)
-    chk.check_symmetric("K", K)
-    planar = isinstance(sliders, PlanarSliders)
-    if not (planar or isinstance(sliders, Sliders)):
-        raise InputError("sliders", type(sliders).__name__,
-                         "seisrack.dynamics.Sliders or seisrack.dynamics.PlanarSliders")
-    if not (isinstance(dt, int | float) and np.isfinite(dt) and dt > 0):
-        raise InputError("dt", dt, "a finite time step > 0 s")
-    if not (np.isfinite(g) and g > 0):
-        raise InputError("g", g, "a finite gravity > 0 m/s²")
-    sliders.check_dofs(n)
-    lengths = [np.shape(x)[0] for x in (ground_accel, force, vertical_accel)
-               if x is not None and np.ndim(x) >= 1]
-    if n_steps is None:
-        if not lengths:
-            raise InputError("n_steps", None, "a number of steps when no excitation is given")
-        n_steps = lengths[0] - 1
-    if isinstance(n_steps, bool) or int(n_steps) != n_steps or n_steps < 1:
-        raise InputError("n_steps", n_steps, "an integer >= 1")
-    n_steps = int(n_steps)
-    n_t = n_steps + 1
-    av = None if vertical_accel is None else chk.series("vertical_accel", vertical_accel, (n_t,))
-    rv = None
-    if av is not None and vertical_influence is not None:
-        rv = chk.series("vertical_influence", vertical_influence, (n,))
-    if chunk_steps is not None:
-        chk.positive_int("chunk_steps", chunk_steps)
-    if save_every is not None:
-        save_every = chk.positive_int("save_every", save_every)
-    if method not in ("auto", "exact", "newmark"):
-        raise InputError("method", method, '"auto", "exact" or "newmark"')
-    if hinges is None:
-        hinges = no_hinges()
-    if not isinstance(hinges, Hinges):
-        raise InputError("hinges", type(hinges).__name__, "a seisrack.dynamics.hinges.Hinges")
-    hinges.check(n)
-    common = dict(dt=float(dt), n_steps=n_steps, av=av, rv=rv, g=float(g), backend=backend,
-                  throw=throw, progress=progress, basis=basis, save_every=save_every,
-                  on_chunk=on_chunk, max_memory=max_memory)
-    if planar:
-        given = {"force": force, "u0": u0, "v0": v0,
-                 "method": method if method == "exact" else None}
-        for name, value in given.items():
-            if value is not None:
-                raise InputError(name, value if name == "method" else "given",
-                                 f"not given for sliders in the plane: the planar scheme has "
-                                 f"no {_PLANAR_UNSUPPORTED[name]}")
-        ag, infl = _planar_ground(ground_accel, influence, n, n_t)
-        chunk = min(int(chunk_steps or (1000 if progress is not None else 5000)), n_steps)
-        return run_planar_scheme(M, C, K, sliders, ag=ag, influence=infl, chunk=chunk,
+    inp = chk.run_inputs(M, C, K, sliders, dt=dt, n_steps=n_steps, ground_accel=ground_accel,
+                         influence=influence, force=force, vertical_accel=vertical_accel,
+                         vertical_influence=vertical_influence, g=g, u0=u0, v0=v0,
+                         chunk_steps=chunk_steps, save_every=save_every, method=method,
+                         hinges=hinges, progress=progress)
+    hinges = inp.hinges
+    bas = choose_basis(basis, inp.M, inp.K, sliders, inp.influences, rv=inp.rv, F=inp.F,
+                       hinges=hinges)
+    m = sliders.count
+    columns = 4 * m + (hinges.count if hinges.nonlinear else 0) if inp.planar else (
+        m + hinges.count)
+    check_memory(kept_samples(inp.n_steps, inp.save_every), inp.chunk, bas.size, columns,
+                 inp.n_steps + 1, max_memory)
+    common = dict(dt=inp.dt, n_steps=inp.n_steps, ag=inp.ag, av=inp.av, rv=inp.rv, g=inp.g,
+                  backend=backend, throw=throw, progress=progress, basis=bas,
+                  save_every=inp.save_every, chunk=inp.chunk, on_chunk=on_chunk, hinges=hinges)
+    if inp.planar:
+        return run_planar_scheme(inp.M, inp.C, inp.K, sliders, influence=inp.influence,
                                  max_events=500_000 if max_events is None else max_events,
-                                 hinges=hinges, **common)
-    ag = np.zeros(n_t) if ground_accel is None else chk.series(
-        "ground_accel", _one_column(ground_accel), (n_t,))
-    r = np.ones(n) if influence is None else chk.series("influence", _one_column(influence),
-                                                        (n,))
-    F = None if force is None else chk.series("force", force, (n_t, n))
-    q_u0 = np.zeros(n) if u0 is None else chk.series("u0", u0, (n,))
-    q_v0 = np.zeros(n) if v0 is None else chk.series("v0", v0, (n,))
-    chunk = min(int(chunk_steps or (2000 if progress is not None else DEFAULT_CHUNK)), n_steps)
-    return run_line(M, C, K, sliders, ag=ag, r=r, F=F, q_u0=q_u0, q_v0=q_v0,
-                    track_energy=track_energy, chunk=chunk, method=method,
-                    max_events=200_000 if max_events is None else max_events, hinges=hinges,
-                    **common)
-
-
-def _one_column(a):  # noqa: ANN001, ANN202
-    """A (k, 1) array as (k,): sliders on a line take one ground component."""
-    a = np.asarray(a)
-    return a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
-
-
-def _planar_ground(ground_accel, influence, n: int, n_t: int  # noqa: ANN001
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """(n_t, 2) ground accelerations x, z and (n, 2) influence vectors of planar sliders."""
-    if ground_accel is None:
-        return np.zeros((n_t, 2)), np.zeros((n, 2))
-    a = np.asarray(ground_accel, dtype=float)
-    if a.ndim == 1:
-        a = np.column_stack([a, np.zeros_like(a)])
-    a = chk.series("ground_accel", a, (n_t, 2))
-    if influence is None:
-        raise InputError("influence", None, "(n, 2) influence vectors of the x and z ground "
-                         "components for sliders in the plane")
-    r = np.asarray(influence, dtype=float)
-    if r.ndim == 1:
-        r = np.column_stack([r, np.zeros_like(r)])
-    return a, chk.series("influence", r, (n, 2))
+                                 **common)
+    return run_line(inp.M, inp.C, inp.K, sliders, r=inp.influence, F=inp.F, q_u0=inp.u0,
+                    q_v0=inp.v0, track_energy=track_energy, method=method,
+                    max_events=200_000 if max_events is None else max_events, **common)

@@ -14,6 +14,8 @@ import importlib.util
 import logging
 from types import ModuleType
 
+import numpy as np
+
 from seisrack.errors import InputError
 
 _LOG = logging.getLogger(__name__)
@@ -58,3 +60,10 @@ def scheme_kernel(backend: str, numba_module: str, python_module: str
     if backend == "python":
         return importlib.import_module(python_module), backend
     raise InputError("backend", backend, '"auto", "numba" or "python"')
+
+
+def writable(a: np.ndarray) -> np.ndarray:
+    """A C-contiguous, writable float array: numba compiles a separate specialisation for
+    read-only arrays (a compiled model's arrays are locked), so the kernel always gets these."""
+    a = np.ascontiguousarray(a)
+    return a if a.flags.writeable else a.copy()

@@ -17,15 +17,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
-from seisrack.dynamics._setup import _check_memory, _kept_samples
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
-from seisrack.dynamics.kernels import scheme_kernel
+from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event, TimeHistory
-from seisrack.dynamics.run_basis import choose_basis
+from seisrack.dynamics.run_basis import keep_index
 from seisrack.dynamics.sliders import PlanarSliders
 from seisrack.errors import InputError, SolverError
 
@@ -53,14 +51,13 @@ def run_planar_scheme(
     av: np.ndarray | None,
     rv: np.ndarray | None,
     g: float,
-    basis: str | Basis,
+    basis: Basis,
     backend: str,
     save_every: int | None,
     chunk: int,
     on_chunk: Callable[[Chunk], None] | None,
     progress: Callable[[int], None] | None,
     max_events: int,
-    max_memory: float | None,
     throw: bool,
     hinges: Hinges | None = None,
 ) -> TimeHistory:
@@ -84,13 +81,10 @@ def run_planar_scheme(
     m = sliders.count
 
     pat_phys = np.column_stack(loads) if loads else np.zeros((n, 0))
-    bas = choose_basis(basis, M, K, sliders, [influence[:, c] for c in range(2)], rv=rv,
-                       hinges=hinges)
+    bas = basis
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
-    n_keep = _kept_samples(n_steps, save_every)
     nh = hinges.count if hinges.nonlinear else 0
-    _check_memory(n_keep, chunk, nb, 4 * m + nh, n_t, max_memory)
     cq = phi.T @ (C @ phi)
     off = cq - np.diag(np.diag(cq))
     if np.max(np.abs(off), initial=0.0) > 1e-8 * max(np.max(np.abs(np.diag(cq))), 1e-300):
@@ -105,9 +99,9 @@ def run_planar_scheme(
     mod, used = _kernel(backend)
     agx, agz = np.ascontiguousarray(ag[:, 0]), np.ascontiguousarray(ag[:, 1])
 
-    mass, mus, mud = (chk.writable(a) for a in (sliders.mass, sliders.mu_static,
+    mass, mus, mud = (writable(a) for a in (sliders.mass, sliders.mu_static,
                                                   sliders.mu_dynamic))
-    kd = chk.writable(w2)
+    kd = writable(w2)
     T_state = np.zeros((3, nb))
     S_state = np.zeros((6, 2 * m))
     stuck = np.ones(m, dtype=np.bool_)
@@ -118,7 +112,7 @@ def run_planar_scheme(
     Q = hinges.operator(phi)[:nh]
     hst = hinges.initial_state()[:nh]
     # writable: a read-only array (a compiled model's) is another numba specialisation
-    h_k, h_law, h_par, h_th0 = (chk.writable(a[:nh]) for a in
+    h_k, h_law, h_par, h_th0 = (writable(a[:nh]) for a in
                                 (hinges.k, hinges.law, hinges.par, hinges.theta0))
     HW = np.zeros((4, nh))
     e_state = np.zeros(4)
@@ -129,7 +123,7 @@ def run_planar_scheme(
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
             np.empty((chunk + 1, nh)), np.empty((chunk + 1, 5)))
-    keep_idx = _keep_index(n_steps, save_every)
+    keep_idx = keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     kept_N = np.empty((keep_idx.size, m))
     status, n_ev, n_sub, start = 0, 0, 0, 0
@@ -196,12 +190,3 @@ def run_planar_scheme(
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
                       (int(x) for x in stats), strict=True)),
         hinge_moment=khm, hinge_operator=Q, hinge_rotation0=h_th0)
-
-
-def _keep_index(n_steps: int, save_every: int | None) -> np.ndarray:
-    if save_every is None:
-        return np.array([0, n_steps])
-    idx = np.arange(0, n_steps + 1, save_every)
-    if idx[-1] != n_steps:
-        idx = np.append(idx, n_steps)
-    return idx

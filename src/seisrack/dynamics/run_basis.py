@@ -1,22 +1,101 @@
-"""The basis a run integrates in, chosen in one place: :func:`choose_basis` (theory: §10 of
+"""The basis a run integrates in, chosen in one place, and the memory the run may take, checked
+before anything is allocated: :func:`choose_basis`, :func:`check_memory` (theory: §10 of
 ``docs/theory/stick_slip_engine.md`` and §5 of ``docs/theory/planar_friction.md``).
 
 Every mode up to ``AUTO_FULL_MAX_DOF`` DOFs (or with ``basis="full"``), the caller's
 :class:`~seisrack.dynamics.basis.Basis`, or a load-dependent Ritz basis of the loads that act:
 the ground loads, the sliders' friction forces and, with nonlinear hinges, their moments. Sliders
 on a line and sliders in the plane start the Ritz basis from their own force patterns.
+:func:`seisrack.dynamics.simulate` calls both once, before its scheme runs.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import numpy as np
 
-from seisrack.dynamics._setup import HINGE_RITZ_BLOCKS, HINGE_RITZ_TOL, given_or_full_basis
-from seisrack.dynamics.basis import Basis, reduced_basis
+from seisrack.dynamics.basis import Basis, full_basis, reduced_basis
 from seisrack.dynamics.hinges import Hinges
 from seisrack.dynamics.sliders import PlanarSliders, Sliders
+from seisrack.errors import InputError
+
+#: with ``basis="auto"``, structures up to this many DOFs keep every mode
+AUTO_FULL_MAX_DOF = 50
+#: with nonlinear hinges the Ritz basis also starts from a unit moment at every hinge (the
+#: static response to the hinges' correction forces), with this many Krylov blocks and this
+#: compression tolerance (a yielding hinge needs its own directions: at 3e-2 they are merged
+#: and peak hinge rotations are 5 % off); on the paper rack with pallets sliding and hinges
+#: yielding, 16 vectors keep the peaks within 1e-4 of the full basis
+#: (tests/test_engine_hinges.py)
+HINGE_RITZ_BLOCKS = 2
+HINGE_RITZ_TOL = 1e-3
+#: default cap on what one run's kept histories and buffers may take [bytes]
+DEFAULT_MAX_MEMORY = 4 * 2**30
+
+
+def given_or_full_basis(basis, M, K) -> Basis | None:  # noqa: ANN001, N803
+    """The caller's Basis (checked), every mode for ``"full"`` (or ``"auto"`` up to
+    ``AUTO_FULL_MAX_DOF`` DOFs), or None when a reduced basis is to be built."""
+    n = M.shape[0]
+    if isinstance(basis, Basis):
+        if basis.phi.shape[0] != n:
+            raise InputError("basis", f"phi of shape {basis.phi.shape}", f"phi with {n} rows")
+        return basis
+    if basis not in ("auto", "full", "reduced"):
+        raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    if basis == "full" or (basis == "auto" and n <= AUTO_FULL_MAX_DOF):
+        return full_basis(M, K)
+    return None
+
+
+def kept_samples(n_steps: int, save_every: int | None) -> int:
+    """How many samples a run of ``n_steps`` keeps (every ``save_every``-th and the last;
+    ``None``: the first and the last)."""
+    if save_every is None:
+        return 2
+    return n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
+
+
+def keep_index(n_steps: int, save_every: int | None) -> np.ndarray:
+    """The steps a run keeps (:func:`kept_samples` of them)."""
+    if save_every is None:
+        return np.array([0, n_steps])
+    idx = np.arange(0, n_steps + 1, save_every)
+    if idx[-1] != n_steps:
+        idx = np.append(idx, n_steps)
+    return idx
+
+
+def memory_budget(max_memory: float | None) -> float | None:
+    """Bytes one run may take: ``max_memory`` if given, else half of the memory free now and
+    at most :data:`DEFAULT_MAX_MEMORY` (studies run several at once; ask for more with
+    ``max_memory=``); None where the free memory cannot be read."""
+    if max_memory is not None:
+        return max_memory
+    try:
+        avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return None
+    return min(0.5 * avail, DEFAULT_MAX_MEMORY)
+
+
+def check_memory(n_keep: int, chunk: int, nb: int, m: int, n_t: int,
+                 max_memory: float | None) -> None:
+    """Refuse a run whose histories and buffers would not fit, before allocating them."""
+    per_row = 8 * (3 * nb + 4 * m + 5) + m
+    need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
+    max_memory = memory_budget(max_memory)
+    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
+        return
+    if need > max_memory:
+        raise InputError(
+            "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "
+            f"{m} sliders ({need / 2**30:.2f} GiB)",
+            f"a run that fits in {max_memory / 2**30:.2f} GiB",
+            hint="Keep fewer samples (save_every=k, or None with on_chunk for peaks only)",
+        )
 
 
 def choose_basis(basis: str | Basis, M, K, sliders: Sliders | PlanarSliders,  # noqa: ANN001, N803

@@ -14,8 +14,7 @@ import numpy as np
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import blas_controller
-from seisrack.dynamics._setup import memory_budget
-from seisrack.dynamics.kernels import scheme_kernel
+from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
     DEFAULT_TOL,
@@ -26,6 +25,7 @@ from seisrack.dynamics.local.basis import (
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory
 from seisrack.dynamics.local.sliders import LocalSliders
 from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event
+from seisrack.dynamics.run_basis import keep_index, memory_budget
 from seisrack.errors import InputError, SolverError
 
 _LOG = logging.getLogger(__name__)
@@ -176,7 +176,7 @@ def simulate_local(
         if worst > 0.2:
             _LOG.warning("local basis: static energy error %.3g of the load patterns", worst)
     N = basis.size
-    n_keep = _keep_index(n_steps, save_every).size
+    n_keep = keep_index(n_steps, save_every).size
     _check_memory(n_keep, chunk, N if keep_coordinates else 0, m, basis, max_memory)
 
     P, ps = support_rows(basis, sliders)
@@ -193,7 +193,7 @@ def simulate_local(
     gz = g + (av if av is not None else np.zeros(n_t))
     mod, used = _kernel(backend)
 
-    w = chk.writable
+    w = writable
     mats = [w(getattr(basis, k)) for k in ("Md", "Cd", "Kd", "Mo", "Co", "Ko")]
     sizes, offsets = w(basis.sizes), w(basis.offsets)
     mass, mus, mud = w(sliders.mass), w(sliders.mu_static), w(sliders.mu_dynamic)
@@ -212,7 +212,7 @@ def simulate_local(
     bufs = (np.empty((chunk + 1, nq)), np.empty((chunk + 1, nq)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m, 2)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m), dtype=np.bool_), np.empty((chunk + 1, 5)))
-    keep_idx = _keep_index(n_steps, save_every)
+    keep_idx = keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     stats = np.zeros(7, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
@@ -275,15 +275,6 @@ def simulate_local(
                       strict=True)))
 
 
-def _keep_index(n_steps: int, save_every: int | None) -> np.ndarray:
-    if save_every is None:
-        return np.array([0, n_steps])
-    idx = np.arange(0, n_steps + 1, save_every)
-    if idx[-1] != n_steps:
-        idx = np.append(idx, n_steps)
-    return idx
-
-
 def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis) -> int:
     """Bytes the run's kept histories, chunk buffers and kernel work arrays take."""
     per_row = 8 * (2 * nq + 6 * m + 5) + m
@@ -304,4 +295,3 @@ def _check_memory(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis,
             f"({need / 2**30:.2f} GiB)", f"a run that fits in {max_memory / 2**30:.2f} GiB",
             hint="Keep fewer samples (save_every=k, or None with on_chunk), or "
                  "keep_coordinates=False")
-
