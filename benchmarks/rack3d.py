@@ -95,7 +95,7 @@ def _case(path: str, motion, mu: float | None = None, tol: float | None = None, 
         M = model.M_sparse
         basis = planar_basis(M, model.K_sparse, sl, np.column_stack([M @ model.r_x,
                                                                      M @ model.r_z]),
-                             "reduced", tol=tol)
+                             tol=tol)
     run_rack(model, motion.__class__(motion.x[:201], motion.z[:201], None, motion.dt,
                                      motion.names), save_every=None, basis=basis)  # warm
     walls, cpus = [], []

@@ -80,7 +80,7 @@ def run_case(engine: str, path: str, seconds: float) -> dict:
                        work=r.history.work, energy=r.history.energy_error(),
                        peaks=peaks.tolist(), fell=sorted(f.pallet for f in r.falls))
         else:
-            from seisrack.analysis.local_run import run_rack_local
+            from seisrack.analysis.engines import run_rack_local
             from seisrack.dynamics.local.racks import rack_basis
 
             k = 2

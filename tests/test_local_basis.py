@@ -25,7 +25,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from seisrack.analysis.local_run import run_rack_local
+from seisrack.analysis.engines import run_rack_local
 from seisrack.dynamics.local import LocalSliders, local_basis, measure_error
 from seisrack.dynamics.local.basis import dense
 from seisrack.dynamics.local.racks import rack_basis, rack_slices

@@ -103,3 +103,31 @@ def test_bad_combinations_are_refused_by_name(tmp_path, capsys):
     with pytest.raises(InputError) as exc:
         run_rack(model, rec, engine="fast")
     assert exc.value.field == "engine"
+
+
+def test_a_prepared_run_serves_its_own_engine_only():
+    """A study prepares once (``prepare_run``) and runs many times: a run prepared for one
+    engine is refused by name on the other, and a local one gives the same run as preparing
+    on the fly."""
+    from dataclasses import replace
+
+    from seisrack.analysis import prepare_run
+
+    rec = load_builtin_record("elcentro_1940_ns")
+    rec = replace(rec, accel=rec.accel[:int(round(1.0 / rec.dt)) + 1])
+    model = compile_rack(load_rack(ROOT / "examples/paper_rack.toml"))
+    default = prepare_run(model)
+    local = prepare_run(model, engine="local")
+    assert local.engine == "local" and default.engine == "default"
+    with pytest.raises(InputError) as exc:
+        run_rack(model, rec, engine="local", prepared=default)
+    assert exc.value.field == "prepared" and 'engine="local"' in exc.value.allowed
+    with pytest.raises(InputError) as exc:
+        run_rack(model, rec, prepared=local)
+    assert exc.value.field == "prepared" and "local engine" in exc.value.value
+    with pytest.raises(InputError) as exc:
+        prepare_run(model, engine="fast")
+    assert exc.value.field == "engine"
+    a = run_rack(model, rec, engine="local", prepared=local)
+    b = run_rack(model, rec, engine="local")
+    np.testing.assert_array_equal(a.pallet_sliding, b.pallet_sliding)

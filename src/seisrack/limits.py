@@ -47,7 +47,7 @@ COMPILE_S_PER_DOF_PALLET = 2.0e-8
 #: Fraction of the memory available now that one command may plan to use.
 MEMORY_FRACTION = 0.5
 #: [B] ceiling of that budget whatever the machine: the engine's own ceiling
-#: (``seisrack.dynamics._setup.DEFAULT_MAX_MEMORY``), which it would apply later anyway.
+#: (``seisrack.dynamics._store.DEFAULT_MAX_MEMORY``), which it would apply later anyway.
 MEMORY_CEILING = 4 * 2**30
 #: Most samples of a record (generated, or padded with free vibration): 10 million samples
 #: (28 h at 0.01 s) are 80 MB per array; longer is a unit error (ms for s).

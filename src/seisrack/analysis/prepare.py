@@ -1,11 +1,13 @@
 """What every run of one compiled rack shares, prepared once: :func:`prepare_run`.
 
-The basis the engine integrates in (:func:`seisrack.dynamics.run_basis.choose_basis`: every mode
-of a small rack, a load-dependent Ritz basis of a large one), the recovery and design operators
-projected onto it, and the rack's hinges. A study runs one model under many records and
-frictions: it prepares once and hands the :class:`PreparedRun` to every
-:func:`~seisrack.analysis.run_rack`. Friction does not enter what is prepared, so a run may use a
-model whose pallet friction differs from the prepared one's.
+The basis the engine integrates in (default engine:
+:func:`seisrack.dynamics.run_basis.choose_basis`, every mode of a small rack, a load-dependent
+Ritz basis of a large one; local engine: :func:`seisrack.dynamics.local.racks.rack_basis`, with
+its measured error), the recovery and design operators projected onto it
+(:mod:`seisrack.analysis.operators`), and the rack's hinges. A study runs one model under many
+records and frictions: it prepares once and hands the :class:`PreparedRun` to every
+:func:`~seisrack.analysis.run_rack`. Friction does not enter what is prepared, so a run may use
+a model whose pallet friction differs from the prepared one's.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from seisrack.analysis.hinges import rack_hinges
-from seisrack.analysis.peaks import RackOperators, rack_operators
+from seisrack.analysis.operators import RackOperators, rack_operators
 from seisrack.dynamics import PlanarSliders, Sliders
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges
@@ -35,7 +37,8 @@ class PreparedRun:
 
     basis: the engine's basis; ops: the rack operators projected onto it; hinges: the rack's
     nonlinear hinges (None when every connection is elastic); vertical: whether the basis holds
-    the vertical load (runs with a vertical component); n_dof: the model's size (checked).
+    the vertical load (runs with a vertical component); n_dof: the model's size (checked);
+    engine: the engine the basis is for ("default" or "local").
     """
 
     basis: Basis
@@ -43,6 +46,7 @@ class PreparedRun:
     hinges: Hinges | None
     vertical: bool
     n_dof: int
+    engine: str = "default"
 
     def __post_init__(self) -> None:
         _locked(self)  # shared by every run of the model
@@ -76,24 +80,48 @@ def model_cache(model: FrameModel) -> dict:
 
 
 def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: bool = False,
-                design: bool = True) -> PreparedRun:
-    """The :class:`PreparedRun` of ``model`` (cached per model for a named basis: a compiled
-    model is immutable, so the cache cannot go stale)."""
+                design: bool = True, engine: str = "default") -> PreparedRun:
+    """The :class:`PreparedRun` of ``model`` for ``engine`` (cached per model for a named
+    basis: a compiled model is immutable, so the cache cannot go stale). The local engine
+    takes its own basis (``basis`` left "auto")."""
     given = isinstance(basis, Basis)
     if not given and basis not in ("auto", "full", "reduced"):
         raise InputError("basis", basis, '"auto", "full", "reduced" or a seisrack Basis')
+    if engine not in ("default", "local"):
+        raise InputError("engine", engine, '"default" or "local"')
     cache = {} if given else model_cache(model)
-    key = (None if given else basis, bool(vertical), bool(design))
+    key = (engine, None if given else basis, bool(vertical), bool(design))
     hit = cache.get(key)
     if hit is None:
-        sliders = rack_sliders(model)
-        hinges = rack_hinges(model)
-        bas = choose_basis(basis, model.M_sparse, model.K_sparse, sliders, model.influence,
-                           rv=model.r_y if vertical else None, hinges=hinges)
-        ops = rack_operators(model, bas.phi, design=design)
-        hit = cache[key] = PreparedRun(basis=bas, ops=ops, hinges=hinges, vertical=vertical,
-                                       n_dof=model.n_dof)
+        hinges, sliders = None, rack_sliders(model)
+        if engine == "local":
+            from seisrack.dynamics.local.racks import rack_basis
+
+            bas = rack_basis(model, vertical=vertical)
+            phi = bas.matrix().tocsr()
+        else:
+            hinges = rack_hinges(model)
+            bas = choose_basis(basis, model.M_sparse, model.K_sparse, sliders, model.influence,
+                               rv=model.r_y if vertical else None, hinges=hinges)
+            phi = bas.phi
+        hit = cache[key] = PreparedRun(basis=bas, ops=rack_operators(model, phi, design=design),
+                                       hinges=hinges, vertical=vertical, n_dof=model.n_dof,
+                                       engine=engine)
     return hit
+
+
+def checked_prepared(prepared: PreparedRun, model: FrameModel, engine: str) -> PreparedRun:
+    """``prepared`` if it was prepared for ``model``'s size and for ``engine``."""
+    if not isinstance(prepared, PreparedRun):
+        raise InputError("prepared", type(prepared).__name__,
+                         "a seisrack.analysis.PreparedRun (prepare_run(model))")
+    if prepared.n_dof != model.n_dof:
+        raise InputError("prepared", f"a prepared run of {prepared.n_dof} DOFs",
+                         f"prepare_run(model) of this model ({model.n_dof} DOFs)")
+    if prepared.engine != engine:
+        raise InputError("prepared", f"a run prepared for the {prepared.engine} engine",
+                         f'prepare_run(model, engine="{engine}") for engine="{engine}"')
+    return prepared
 
 
 def _locked(obj):  # noqa: ANN001, ANN202

@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from seisrack.analysis.engines import simulate_rack
 from seisrack.analysis.hinges import HingePeaks, hinge_response
 from seisrack.analysis.pallet_contacts import ContactTracker
 from seisrack.analysis.peaks import (  # noqa: F401  (lowpass re-exported)
@@ -29,13 +30,18 @@ from seisrack.analysis.peaks import (  # noqa: F401  (lowpass re-exported)
     lowpass,
     with_direction,
 )
-from seisrack.analysis.prepare import RIGID_MU, PreparedRun, prepare_run, rack_sliders
+from seisrack.analysis.prepare import (  # noqa: F401  (RIGID_MU re-exported)
+    RIGID_MU,
+    PreparedRun,
+    checked_prepared,
+    prepare_run,
+)
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
     SLIDING_TOL_M,
     RackResponse,
 )
-from seisrack.dynamics import Sliders, TimeHistory, simulate
+from seisrack.dynamics import TimeHistory
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.engine import single_blas_thread
 from seisrack.errors import InputError, SolverError
@@ -125,7 +131,7 @@ def run_rack(
     engine: "default" (the engines above) or "local" (opt-in, issue 22: a local basis and
         each pallet's events resolved inside the step, cost linear in the rack's length;
         linear connections and Coulomb friction only, ``method`` and ``basis`` left "auto";
-        :mod:`seisrack.analysis.local_run`).
+        :mod:`seisrack.analysis.engines`).
     """
     if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
             and accel_filter_hz > 0):
@@ -141,36 +147,27 @@ def run_rack(
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))
     ag, av = mot.on_grid(k, model.n_dir)
-    if engine == "local":
-        return _run_local(model, mot, ag, av, h, prepared=prepared, backend=backend,
-                          rigid_companion=rigid_companion, progress=progress, throw=throw,
-                          save_every=save_every, max_memory=max_memory,
-                          accel_filter_hz=accel_filter_hz)
-    if prepared is None:
-        prepared = prepare_run(model, basis=basis, vertical=av is not None)
-    elif prepared.n_dof != model.n_dof:
-        raise InputError("prepared", f"a prepared run of {prepared.n_dof} DOFs",
-                         f"prepare_run(model) of this model ({model.n_dof} DOFs)")
-    ops, bas, hinges = prepared.ops, prepared.basis, prepared.hinges
-    sliders = rack_sliders(model)
-    held = rack_sliders(model, RIGID_MU) if rigid_companion and model.n_pallets else None
-    infl = np.column_stack(model.influence)
-    common = dict(dt=h, ground_accel=ag, influence=infl, vertical_accel=av,
-                  vertical_influence=None if av is None else model.r_y, g=model.g,
-                  backend=backend, throw=throw, basis=bas)
-    line = isinstance(sliders, Sliders)
-    if line:
-        common["method"] = method
+    if prepared is not None:
+        checked_prepared(prepared, model, engine)
+    else:
+        prepared = prepare_run(model, basis=basis, vertical=av is not None, engine=engine)
+    ops, hinges = prepared.ops, prepared.hinges
+    line = model.n_dir == 1
     # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
     # engine takes Newmark for sliders in the plane, for a rack on a line exactly when asked
-    # or when the damping has a mass term
-    newmark = not line or method == "newmark" or hinges is not None or (
-        sliders.velocity_dependent) or (
-        method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
+    # or when the damping has a mass term; the local engine's accelerations are already
+    # central differences of its velocities
+    weakening = (np.asarray(model.pallet_friction_rate) > 0.0) & (
+        np.asarray(model.pallet_mu_static) > np.asarray(model.pallet_mu_dynamic))
+    newmark = engine == "default" and (
+        not line or method == "newmark" or hinges is not None or bool(np.any(weakening)) or (
+            method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0))
     tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
+    rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False) if (
+        rigid_companion and model.n_pallets) else None
     contacts = ContactTracker(model.layout, model.n_pallets)
-    hpk = None if hinges is None else HingePeaks(hinges, bas.phi)
+    hpk = None if hinges is None else HingePeaks(hinges, prepared.basis.phi)
 
     def on_chunk(chunk) -> None:  # noqa: ANN001
         tracker(chunk)
@@ -178,34 +175,18 @@ def run_rack(
         if hpk is not None:
             hpk(chunk)
 
-    try:
-        hist = simulate(model.M_sparse, model.C_sparse, model.K_sparse, sliders, **common,
-                        progress=progress, save_every=save_every, on_chunk=on_chunk,
-                        track_energy=track_energy, max_memory=max_memory,
-                        hinges=hinges)
-    except InputError as exc:
-        if not exc.field.startswith("sliders.friction_rate["):
-            raise
-        j = int(exc.field.split("[")[1].rstrip("]"))
-        raise InputError(f"friction_rate of pallet {j + 1} (level {model.pallet_level[j] + 1})",
-                         exc.value, exc.allowed, source=getattr(model, "title", None) or None,
-                         hint=exc.hint) from None
-    if (hist.method == "newmark") != newmark:  # pragma: no cover - guards the rule above
+    hist = simulate_rack(model, prepared, ag, av, h, method=method, backend=backend, throw=throw,
+                         on_chunk=on_chunk, progress=progress, save_every=save_every,
+                         track_energy=track_energy, max_memory=max_memory, companion=rig)
+    if engine == "default" and (hist.method == "newmark") != newmark:  # pragma: no cover
         raise SolverError(f"run_rack expected the {'newmark' if newmark else 'exact'} "
                           f"method but the engine used {hist.method}")
     peaks = tracker.result()
+    rigid_peak = None if rig is None else rig.result()["beam_acceleration_magnitude"]
     acc_full = tracker.level_acceleration()
     acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
     peaks["beam_acceleration_filtered"] = (
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
-    rigid_peak = None
-    if held is not None:
-        rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False)
-        if line:
-            common["method"] = "exact" if hist.method == "exact" else method
-        simulate(model.M_sparse, model.C_sparse, model.K_sparse, held, **common,
-                 save_every=None, on_chunk=rig, track_energy=False, hinges=hinges)
-        rigid_peak = rig.result()["beam_acceleration_magnitude"]
     resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
@@ -213,49 +194,6 @@ def run_rack(
                    beam_acceleration_filtered=None if acc_filt is None
                    else squeeze(acc_filt[idx]),
                    hinges=None if hinges is None else hinge_response(model, hist, hpk))
-
-
-def _run_local(model: FrameModel, mot: GroundMotion, ag: np.ndarray, av: np.ndarray | None,
-               h: float, *, prepared: PreparedRun | None, backend: str, rigid_companion: bool,
-               progress: Callable[[int], None] | None, throw: bool, save_every: int | None,
-               max_memory: float | None, accel_filter_hz: float) -> RackResponse:
-    """:func:`run_rack` on the local engine (:mod:`seisrack.analysis.local_run`)."""
-    from seisrack.analysis.local_run import prepare_local, simulate_rack_local
-    from seisrack.dynamics.local.basis import LocalBasis
-
-    if prepared is None or not isinstance(prepared.basis, LocalBasis):
-        prepared = prepare_local(model, vertical=av is not None)
-    ops = prepared.ops
-    # the engine's accelerations are already central differences of the velocities
-    tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, keep_accel=True,
-                          design=True)
-    contacts = ContactTracker(model.layout, model.n_pallets)
-
-    def on_chunk(chunk) -> None:  # noqa: ANN001
-        tracker(chunk)
-        contacts(chunk)
-
-    hist = simulate_rack_local(model, prepared, ag, av, h, on_chunk=on_chunk,
-                               progress=progress, save_every=save_every,
-                               max_memory=max_memory, throw=throw, backend=backend)
-    peaks = tracker.result()
-    acc_full = tracker.level_acceleration()
-    acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
-    peaks["beam_acceleration_filtered"] = (
-        None if acc_filt is None else np.abs(acc_filt).max(axis=0))
-    rigid_peak = None
-    if rigid_companion and model.n_pallets:
-        rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False)
-        simulate_rack_local(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=rig,
-                            save_every=None, max_memory=max_memory, throw=throw,
-                            backend=backend)
-        rigid_peak = rig.result()["beam_acceleration_magnitude"]
-    resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
-    idx = hist.sample_index
-    squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
-    return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
-                   beam_acceleration_filtered=None if acc_filt is None
-                   else squeeze(acc_filt[idx]), hinges=None)
 
 
 def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
@@ -307,6 +245,8 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
                      for d in range(nd)], axis=-1)
     sq = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
     lay = model.layout
+    impacts = tuple(contacts.impacts())
+    falls = tuple(contacts.falls())
     return RackResponse(
         t=hist.t, ground_accel=sq(agk), beam_displacement=sq(disp), beam_acceleration=sq(acc),
         beam_acceleration_raw=sq(acc_raw), contact_force=sq(force), base_shear=sq(base_shear),
@@ -324,7 +264,6 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
         directions=model.directions, pallet_slot=np.asarray(model.pallet_slot),
         vertical_accel=None if av is None else av[idx], angle_deg=mot.angle_deg,
         level_y=np.asarray(model.level_y), fall_front=np.asarray(lay.fall_front),
-        fall_rear=np.asarray(lay.fall_rear), falls=tuple(contacts.falls()),
-        impacts=tuple(contacts.impacts()),
+        fall_rear=np.asarray(lay.fall_rear), falls=falls, impacts=impacts,
         pallet_row=np.asarray(model.pallet_row) if model.n_rows > 1 else None,
     )

@@ -25,7 +25,6 @@ from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split
 from seisrack.dynamics.kernels import get_kernel, writable
 from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
-from seisrack.dynamics.run_basis import kept_samples
 from seisrack.dynamics.sliders import Sliders
 from seisrack.errors import InputError, SolverError
 
@@ -59,7 +58,6 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
     bas = basis
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
-    n_keep = kept_samples(n_steps, save_every)
 
     cq = phi.T @ (C @ phi)
     off = cq - np.diag(np.diag(cq))
@@ -101,7 +99,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
                                 (hinges.k, hinges.law, hinges.par, hinges.theta0))
     rate = np.where(sliders.mu_static > sliders.mu_dynamic, sliders.friction_rate, 0.0)
     buf = _Buffers(chunk + 1, nb, m, nh)
-    keep = _Kept(n_keep, nb, m, track_energy, nh)
+    keep = _Kept(n_steps, save_every, nb, m, track_energy, nh)
     ev_time = np.empty(max_events + 1)
     ev_slider = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)

@@ -1,8 +1,68 @@
-"""Buffers of the engine: one chunk at full rate, and the samples a run keeps."""
+"""Buffers of the engine: one chunk at full rate, and the samples a run keeps
+(:func:`keep_index`: every ``save_every``-th step and the last one), with the memory they take
+checked before anything is allocated (:func:`check_memory`)."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
+
+from seisrack.errors import InputError
+
+#: default cap on what one run's kept histories and buffers may take [bytes]
+DEFAULT_MAX_MEMORY = 4 * 2**30
+
+
+def kept_samples(n_steps: int, save_every: int | None) -> int:
+    """How many samples a run of ``n_steps`` keeps (every ``save_every``-th and the last;
+    ``None``: the first and the last)."""
+    if save_every is None:
+        return 2
+    return n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
+
+
+def keep_index(n_steps: int, save_every: int | None) -> np.ndarray:
+    """The steps a run keeps (:func:`kept_samples` of them)."""
+    if save_every is None:
+        return np.array([0, n_steps])
+    idx = np.arange(0, n_steps + 1, save_every)
+    if idx[-1] != n_steps:
+        idx = np.append(idx, n_steps)
+    return idx
+
+
+def memory_budget(max_memory: float | None) -> float | None:
+    """Bytes one run may take: ``max_memory`` if given, else half of the memory free now and
+    at most :data:`DEFAULT_MAX_MEMORY` (studies run several at once; ask for more with
+    ``max_memory=``); None where the free memory cannot be read."""
+    if max_memory is not None:
+        return max_memory
+    try:
+        avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return None
+    return min(0.5 * avail, DEFAULT_MAX_MEMORY)
+
+
+def check_memory(n_steps: int, save_every: int | None, chunk: int, nb: int, m: int,
+                 max_memory: float | None) -> None:
+    """Refuse a run of ``n_steps`` keeping every ``save_every``-th sample of ``nb``
+    coordinates and ``m`` slider columns whose histories and buffers would not fit, before
+    allocating them."""
+    n_keep, n_t = kept_samples(n_steps, save_every), n_steps + 1
+    per_row = 8 * (3 * nb + 4 * m + 5) + m
+    need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
+    max_memory = memory_budget(max_memory)
+    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
+        return
+    if need > max_memory:
+        raise InputError(
+            "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "
+            f"{m} sliders ({need / 2**30:.2f} GiB)",
+            f"a run that fits in {max_memory / 2**30:.2f} GiB",
+            hint="Keep fewer samples (save_every=k, or None with on_chunk for peaks only)",
+        )
 
 
 class Buffers:
@@ -22,7 +82,9 @@ class Buffers:
 class Kept:
     """The samples a run keeps: every ``save_every``-th step and the last one."""
 
-    def __init__(self, n_keep: int, nb: int, m: int, energy: bool, nh: int = 0) -> None:
+    def __init__(self, n_steps: int, save_every: int | None, nb: int, m: int, energy: bool,
+                 nh: int = 0) -> None:
+        n_keep = kept_samples(n_steps, save_every)
         self.q = np.empty((n_keep, nb))
         self.qd = np.empty((n_keep, nb))
         self.qdd = np.empty((n_keep, nb))

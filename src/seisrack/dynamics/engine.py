@@ -28,18 +28,16 @@ from seisrack.dynamics._blas import single_blas_thread  # noqa: F401  (re-export
 from seisrack.dynamics._chunk import Chunk  # noqa: F401  (re-exported: on_chunk's argument)
 from seisrack.dynamics._inputs import DEFAULT_CHUNK  # noqa: F401  (re-exported)
 from seisrack.dynamics._run_line import run_line
+from seisrack.dynamics._store import DEFAULT_MAX_MEMORY, check_memory  # noqa: F401
 from seisrack.dynamics.basis import Basis, full_basis
 from seisrack.dynamics.hinges import Hinges
 from seisrack.dynamics.planar import run_planar_scheme
 from seisrack.dynamics.results import TimeHistory
 from seisrack.dynamics.run_basis import (  # noqa: F401  (constants re-exported: the engine's API)
     AUTO_FULL_MAX_DOF,
-    DEFAULT_MAX_MEMORY,
     HINGE_RITZ_BLOCKS,
     HINGE_RITZ_TOL,
-    check_memory,
     choose_basis,
-    kept_samples,
 )
 from seisrack.dynamics.sliders import PlanarSliders, Sliders
 
@@ -141,8 +139,7 @@ def simulate(
     m = sliders.count
     columns = 4 * m + (hinges.count if hinges.nonlinear else 0) if inp.planar else (
         m + hinges.count)
-    check_memory(kept_samples(inp.n_steps, inp.save_every), inp.chunk, bas.size, columns,
-                 inp.n_steps + 1, max_memory)
+    check_memory(inp.n_steps, inp.save_every, inp.chunk, bas.size, columns, max_memory)
     common = dict(dt=inp.dt, n_steps=inp.n_steps, ag=inp.ag, av=inp.av, rv=inp.rv, g=inp.g,
                   backend=backend, throw=throw, progress=progress, basis=bas,
                   save_every=inp.save_every, chunk=inp.chunk, on_chunk=on_chunk, hinges=hinges)

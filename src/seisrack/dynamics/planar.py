@@ -19,11 +19,11 @@ import numpy as np
 
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
+from seisrack.dynamics._store import keep_index
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event, TimeHistory
-from seisrack.dynamics.run_basis import keep_index
 from seisrack.dynamics.sliders import PlanarSliders
 from seisrack.errors import InputError, SolverError
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import blas_controller
+from seisrack.dynamics._store import keep_index, memory_budget
 from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
@@ -25,7 +26,6 @@ from seisrack.dynamics.local.basis import (
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory
 from seisrack.dynamics.local.sliders import LocalSliders
 from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event
-from seisrack.dynamics.run_basis import keep_index, memory_budget
 from seisrack.errors import InputError, SolverError
 
 _LOG = logging.getLogger(__name__)

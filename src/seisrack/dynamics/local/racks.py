@@ -50,16 +50,17 @@ def rack_slices(model) -> np.ndarray:  # noqa: ANN001
     return np.unique(raw, return_inverse=True)[1].astype(np.int64)
 
 
-def rack_sliders(model) -> LocalSliders:  # noqa: ANN001
+def local_rack_sliders(model) -> LocalSliders:  # noqa: ANN001
     """The pallets of ``model``: 3D, resting on the front and rear beam nodes, sliding in x
     and z; 2D, on one DOF, sliding along x."""
     return LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass, model.pallet_mu_static,
                         model.pallet_mu_dynamic)
 
 
-def rack_global_loads(model, mass: sp.spmatrix) -> np.ndarray:  # noqa: ANN001
-    """(n, g) a uniform load on every beam level (3D: per side, x and z; 2D: x), weighted by
-    ``mass``: their static responses carry the sway of the whole row into every patch."""
+def rack_level_patterns(model) -> np.ndarray:  # noqa: ANN001
+    """(n, g) a unit load on every DOF of each beam level (3D: per side, x and z; 2D: x);
+    weighted by the mass they are the global loads, whose static responses carry the sway of
+    the whole row into every patch."""
     x, nd = _node_x(model)
     nodes = np.asarray(model.mesh.nodes)
     ys = np.asarray(model.level_y)
@@ -82,7 +83,7 @@ def rack_global_loads(model, mass: sp.spmatrix) -> np.ndarray:  # noqa: ANN001
                     continue
                 e = np.zeros(n)
                 e[d] = 1.0
-                cols.append(mass @ e)
+                cols.append(e)
     return np.column_stack(cols) if cols else np.zeros((n, 0))
 
 
@@ -93,15 +94,16 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
     error measured against the full model (``check``: "static", "full" or "none")."""
     from seisrack.dynamics.local.basis import DEFAULT_TOL, local_basis, measure_error
 
-    sl = rack_sliders(model)
+    slices, levels = rack_slices(model), rack_level_patterns(model)
+    sl = local_rack_sliders(model)
     n = model.K_sparse.shape[0]
     M = model.M_sparse
     extra = sl.attached_mass(n)
     infl = list(model.influence) + ([model.r_y] if vertical else [])
     loads = np.column_stack([M @ r for r in infl])
     pats = sl.patterns(n)
-    b = local_basis(M, model.C_sparse, model.K_sparse, rack_slices(model), loads, pats,
-                    global_loads=rack_global_loads(model, M + extra), mass_extra=extra,
+    b = local_basis(M, model.C_sparse, model.K_sparse, slices, loads, pats,
+                    global_loads=(M + extra) @ levels, mass_extra=extra,
                     tol=DEFAULT_TOL if tol is None else tol,
                     patch=RACK_PATCH if patch is None else patch)
     if check != "none":
@@ -111,7 +113,7 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
     return b
 
 
-def simulate_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None,  # noqa: ANN001, ANN201
+def simulate_local_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None,  # noqa: ANN001, ANN201
                   basis=None, **kw):  # noqa: ANN001, ANN003
     """:func:`~seisrack.dynamics.local.simulate_local` on a compiled rack: ``ground`` (n_t,
     n_dir) the down-aisle (and, 3D, cross-aisle) accelerations [m/s²] on the analysis grid;
@@ -121,7 +123,7 @@ def simulate_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None, 
     infl = np.array(model.influence)
     if basis is None:
         basis = rack_basis(model, vertical=vertical_accel is not None)
-    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse, rack_sliders(model),
+    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse, local_rack_sliders(model),
                           dt=dt, ground=np.reshape(ground, (np.shape(ground)[0], -1)),
                           influence=infl, vertical_accel=vertical_accel,
                           vertical_influence=None if vertical_accel is None else model.r_y,

@@ -1,11 +1,9 @@
-"""The local engine (issue 22, ``docs/theory/local_engine.md``) behind the one rack path:
-``run_rack(model, motion, engine="local")``.
-
-What is prepared once per model (the local basis with its measured error, the rack operators
-projected onto it), and one run of the engine returned as the
-:class:`~seisrack.dynamics.results.TimeHistory` the rest of the path reads (peaks, falls,
-writer, report). The engine's chunks are handed on as the usual
-:class:`~seisrack.dynamics._chunk.Chunk`; the reported accelerations are the central
+"""One run of a prepared rack on its engine, :func:`simulate_rack`: the default engine
+(:func:`seisrack.dynamics.simulate`, the line or the planar scheme) or the local engine (issue 22,
+``docs/theory/local_engine.md``, ``run_rack(model, motion, engine="local")``), each returned as
+the :class:`~seisrack.dynamics.results.TimeHistory` the rest of the path reads (peaks, falls,
+writer, report). The local engine's chunks are handed on as the usual
+:class:`~seisrack.dynamics._chunk.Chunk`; its reported accelerations are the central
 differences of the velocities, ``(v[n+1] - v[n-1]) / 2h`` (the trapezoidal rule's own end
 accelerations carry the period-2h residue of the stiff directions, see
 :func:`seisrack.analysis.rack.smoothed_acceleration`).
@@ -19,27 +17,57 @@ from dataclasses import dataclass
 import numpy as np
 
 from seisrack.analysis.pallet_contacts import ContactTracker
-from seisrack.analysis.peaks import rack_operators
-from seisrack.analysis.prepare import PreparedRun, model_cache
+from seisrack.analysis.prepare import RIGID_MU, PreparedRun, rack_sliders
 from seisrack.dynamics._chunk import Chunk
-from seisrack.dynamics.local.racks import rack_basis, simulate_rack
+from seisrack.dynamics.engine import simulate
+from seisrack.dynamics.local.racks import rack_basis, simulate_local_rack
 from seisrack.dynamics.results import TimeHistory
+from seisrack.errors import InputError
 from seisrack.model.frame_model import FrameModel
 
 
-def prepare_local(model: FrameModel, *, vertical: bool = False, design: bool = True
-                  ) -> PreparedRun:
-    """The local basis of ``model`` (its static energy error measured against the full
-    model) and the rack operators projected onto it (cached per model)."""
-    cache = model_cache(model)
-    key = ("local", bool(vertical), bool(design))
-    hit = cache.get(key)
-    if hit is None:
-        b = rack_basis(model, vertical=vertical)
-        ops = rack_operators(model, b.matrix().tocsr(), design=design)
-        hit = cache[key] = PreparedRun(basis=b, ops=ops, hinges=None,
-                                       vertical=vertical, n_dof=model.n_dof)
-    return hit
+def simulate_rack(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
+                  av: np.ndarray | None, h: float, *, method: str = "auto",
+                  backend: str = "auto", throw: bool = True,
+                  on_chunk: Callable[[Chunk], None] | None = None,
+                  progress: Callable[[int], None] | None = None, save_every: int | None = 1,
+                  track_energy: bool = True, max_memory: float | None = None,
+                  companion: Callable[[Chunk], None] | None = None) -> TimeHistory:
+    """The run of ``model`` on the engine it was prepared for: ``ag`` (n_t, n_dir) [m/s²] the
+    horizontal ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one
+    or None. ``companion``: the ``on_chunk`` of a second run with every pallet rigidly held
+    (friction :data:`~seisrack.analysis.prepare.RIGID_MU`, peaks only, the main run's
+    method), made when the rack carries pallets. Returns the main run's history."""
+    hist = None
+    for mu, observer in ((None, on_chunk), (RIGID_MU, companion)):
+        main = mu is None
+        if not main and (observer is None or not model.n_pallets):
+            break
+        kw = dict(on_chunk=observer, progress=progress if main else None,
+                  save_every=save_every if main else None, max_memory=max_memory,
+                  throw=throw, backend=backend)
+        if prepared.engine == "local":
+            run = simulate_rack_local(model, prepared, ag, av, h, mu=mu, **kw)
+        else:
+            sliders = rack_sliders(model, mu)
+            try:
+                run = simulate(
+                    model.M_sparse, model.C_sparse, model.K_sparse, sliders, dt=h,
+                    ground_accel=ag, influence=np.column_stack(model.influence),
+                    vertical_accel=av, vertical_influence=None if av is None else model.r_y,
+                    g=model.g, basis=prepared.basis, hinges=prepared.hinges,
+                    track_energy=track_energy and main,
+                    method=method if main or hist.method != "exact" else "exact", **kw)
+            except InputError as exc:
+                if not exc.field.startswith("sliders.friction_rate["):
+                    raise
+                j = int(exc.field.split("[")[1].rstrip("]"))
+                raise InputError(
+                    f"friction_rate of pallet {j + 1} (level {model.pallet_level[j] + 1})",
+                    exc.value, exc.allowed, source=getattr(model, "title", None) or None,
+                    hint=exc.hint) from None
+        hist = run if main else hist
+    return hist
 
 
 def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
@@ -51,9 +79,9 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
     """One run of the local engine on ``model``: ``ag`` (n_t, n_dir) [m/s²] the horizontal
     ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
     ``mu`` replaces every friction coefficient (the rigid companion)."""
+    from seisrack.dynamics._store import keep_index
     from seisrack.dynamics.local import LocalSliders
     from seisrack.dynamics.local.engine import simulate_local
-    from seisrack.dynamics.run_basis import keep_index
 
     b = prepared.basis
     nd = model.n_dir
@@ -141,7 +169,7 @@ def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa:
             tracker.update(ch.t, ch.sliding, ch.velocity)
 
     kw.setdefault("save_every", None)
-    hist = simulate_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
+    hist = simulate_local_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
                          on_chunk=on_chunk, keep_coordinates=True, **kw)
     return RackRun(peak_sliding=peak, level_peak=level_peak,
                    falls=tracker.falls() if tracker is not None else [], history=hist)
