@@ -111,8 +111,10 @@ def plan(spec: StudySpec) -> StudyPlan:
             if intensity.measure == "sa":
                 period = _first_period(rack, kept, given)
             for name, rec_h, comps in records:
-                im0 = float(np.exp(np.mean([np.log(_intensity_of(
-                    c, intensity.measure, period, intensity.damping)) for c in comps])))
+                ims = [_intensity_of(c, intensity.measure, period, intensity.damping)
+                       for c in comps]
+                # geometric mean of the components; a flat one is refused just below
+                im0 = float(np.exp(np.mean(np.log(ims)))) if min(ims) > 0.0 else 0.0
                 _check_reachable(name, comps[0], im0, levels, intensity, spec.dt, period)
                 angles = (spec.rack_angles[r_index] if spec.rack_angles
                           else _angle_samples(spec, rh, rec_h, occ))
