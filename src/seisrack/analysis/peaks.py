@@ -88,10 +88,11 @@ class PeakTracker:
         if d is not None:
             # one (r, Σk) product per chunk instead of one per quantity
             mats = [d.ops[name] for name in d.names]
-            self._dop = np.ascontiguousarray(np.concatenate(mats, axis=1))
+            # held transposed, (Σk, r): the product with qᵀ is (Σk, n_t), C-ordered
+            self._dop = np.ascontiguousarray(np.concatenate(mats, axis=1).T)
             self._dsplit = np.cumsum([m_.shape[1] for m_ in mats])[:-1]
-            self._dmax_all = np.full(self._dop.shape[1], -np.inf)
-            self._dmin_all = np.full(self._dop.shape[1], np.inf)
+            self._dmax_all = np.full(self._dop.shape[0], -np.inf)
+            self._dmin_all = np.full(self._dop.shape[0], np.inf)
             ns = d.ops["axial"].shape[1]
             self.n_at_max_n = np.zeros((2, ns))  # rows: N, M at the largest |N|
             self.nm_at_max_m = np.zeros((2, ns))  # rows: N, M at the largest |M|
@@ -142,8 +143,9 @@ class PeakTracker:
     def _design(self, q: np.ndarray) -> None:
         d = self.ops.design
         # (k, n_t): every reduction below runs along contiguous rows (several times faster
-        # than along axis 0 of (n_t, k); the values and the first-maximum ties are the same)
-        xt = np.ascontiguousarray((q @ self._dop).T)
+        # than along axis 0 of (n_t, k); the values and the first-maximum ties are the same),
+        # formed as such by the product instead of a transposed copy
+        xt = self._dop @ q.T
         np.maximum(self._dmax_all, xt.max(axis=1, initial=-np.inf), out=self._dmax_all)
         np.minimum(self._dmin_all, xt.min(axis=1, initial=np.inf), out=self._dmin_all)
         vals = dict(zip(d.names, np.split(xt, self._dsplit, axis=0), strict=True))
