@@ -40,8 +40,8 @@ CONNECTOR_ROTATION_MAX = 0.2
 #: moment frames (FEMA 356, Table C1-3); beyond, the rack would have collapsed
 DRIFT_RATIO_MAX = 0.10
 
-__all__ = ["critical_load", "energy_balance", "pallet_mass", "plausibility_warnings",
-           "response_extremes"]
+__all__ = ["basis_cap", "critical_load", "energy_balance", "pallet_mass",
+           "plausibility_warnings", "response_extremes"]
 
 
 def _warning(code: str, message: str, value: float, limit: float, source: str
@@ -104,6 +104,26 @@ def energy_balance(summary: Mapping[str, Any]) -> list[dict[str, Any]]:
         ENERGY_ERROR_MAX, "the engine's energy tests (tests/test_engine_energy.py)")]
 
 
+def basis_cap(summary: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """A reduced basis whose size cap dropped directions of the loads' static responses
+    (``basis.capped_directions`` > 0): the rack is larger than the basis can represent at its
+    compression tolerance, and the run says how much static energy it lost."""
+    b = summary.get("basis")
+    if not isinstance(b, Mapping):
+        return []
+    capped = b.get("capped_directions")
+    if not isinstance(capped, int) or capped <= 0:
+        return []
+    err = b.get("static_energy_error")
+    err_text = f"{100 * err:.3g} %" if isinstance(err, int | float) else "unknown"
+    return [_warning(
+        "basis_cap", f"the reduced basis hit its size cap ({b.get('size')} vectors) and "
+        f"dropped {capped} directions of the loads' static responses (largest static energy "
+        f"error of a load pattern: {err_text}): the rack is larger than the basis represents; "
+        "compare with --basis full if it fits, or with --engine local", capped, 0,
+        "seisrack.dynamics.basis.DEFAULT_MAX_SIZE (issue 22: no silent truncation)")]
+
+
 def _design_max(summary: Mapping[str, Any], key: str) -> tuple[float | None, str]:
     d = summary.get("design") or {}
     q = d.get(key) if isinstance(d, Mapping) else None
@@ -151,7 +171,7 @@ def plausibility_warnings(spec: Any = None, model: Any = None,
     if model is not None:
         out += critical_load(getattr(model, "critical_load_factor", None))
     if summary is not None:
-        out += energy_balance(summary) + response_extremes(summary)
+        out += energy_balance(summary) + response_extremes(summary) + basis_cap(summary)
     return out
 
 

@@ -53,7 +53,10 @@ class Basis:
 
     phi: (n, r); w2: (r,) [rad²/s²] ascending. kind: "full" or "reduced".
     n_modes: basis size (modes of the structure, or Ritz vectors); n_static: Krylov blocks of a
-    reduced basis; highest_mode_hz: highest frequency of the basis [Hz].
+    reduced basis; highest_mode_hz: highest frequency of the basis [Hz]. static_error: the
+    largest static energy error of the load patterns the basis was built from (0: every static
+    response is in the basis; a full basis has none); capped: directions of the loads' static
+    responses above the compression tolerance that the size cap dropped (0: none).
     """
 
     phi: np.ndarray
@@ -62,6 +65,8 @@ class Basis:
     n_modes: int
     n_static: int = 0
     highest_mode_hz: float | None = None
+    static_error: float = 0.0
+    capped: int = 0
 
     @property
     def size(self) -> int:
@@ -74,6 +79,8 @@ class Basis:
             "modes": self.n_modes,
             "ritz_blocks": self.n_static,
             "highest_mode_hz": self.highest_mode_hz,
+            "static_energy_error": self.static_error,
+            "capped_directions": self.capped,
         }
 
 
@@ -149,12 +156,15 @@ def reduced_basis(
     F[:, : loads.shape[1]] = loads
     F[udofs, loads.shape[1] + np.arange(udofs.size)] = 1.0
     block = solve(np.asfortranarray(F))
+    static = block  # K⁻¹ F: the static responses, for the error measured below
     V = np.zeros((n, 0))
-    n_blocks = 0
+    n_blocks, capped = 0, 0
     while n_blocks < blocks and V.shape[1] < max_size:
         # the first block is compressed at ``tol``; later ones drop only dependent directions
         cut = tol if n_blocks == 0 else _DEPENDENT
-        block = _orthonormal_block(block, V, M0, cut, max_size - V.shape[1])
+        block, over = _orthonormal_block(block, V, M0, cut, max_size - V.shape[1])
+        if n_blocks == 0:
+            capped = over
         if block.shape[1] == 0:
             break
         if n_blocks and V.shape[1] + block.shape[1] > max(target_size, 1):
@@ -169,16 +179,43 @@ def reduced_basis(
     except np.linalg.LinAlgError as exc:
         raise SolverError(f"reduced basis: Rayleigh-Ritz failed ({exc})") from exc
     w2 = np.clip(w2, 0.0, None)
+    phi = np.ascontiguousarray(V @ W)
+    err = static_energy_error(phi, w2, F, static)
+    if capped:
+        _LOG.warning("reduced basis: the size cap of %d vectors dropped %d directions of the "
+                     "loads' static responses (largest static energy error %.3g)", max_size,
+                     capped, err)
     return Basis(
-        phi=np.ascontiguousarray(V @ W), w2=w2, kind="reduced", n_modes=int(w2.size),
-        n_static=n_blocks,
+        phi=phi, w2=w2, kind="reduced", n_modes=int(w2.size), n_static=n_blocks,
         highest_mode_hz=float(np.sqrt(w2[-1]) / (2 * np.pi)) if w2.size else None,
+        static_error=err, capped=int(capped),
     )
+
+
+def static_energy_error(phi: np.ndarray, w2: np.ndarray, F: np.ndarray,
+                        static: np.ndarray) -> float:
+    """Largest relative energy error of the static responses ``static = K⁻¹ F`` (n, k) of the
+    loads ``F`` (n, k) in the basis (``phi`` M-orthonormal, ``phiᵀ K phi = diag(w2)``).
+
+    The K-orthogonal projection of x = K⁻¹ f onto the basis has the strain energy
+    Σᵢ (φᵢᵀ f)² / ωᵢ², and x itself fᵀ K⁻¹ f, so the error is
+    1 − Σᵢ (φᵢᵀ f)² / ωᵢ² / (fᵀ x) (0 when x is in the basis); rigid-body directions
+    (ωᵢ = 0) carry no strain energy and are left out.
+    """
+    full = np.einsum("ij,ij->j", F, static)
+    on = full > 1e-300
+    if not np.any(on):
+        return 0.0
+    stiff = w2 > 1e-12 * max(float(np.max(w2, initial=0.0)), 1e-300)
+    proj = phi[:, stiff].T @ F[:, on]
+    kept = np.einsum("ij,ij->j", proj, proj / w2[stiff, None])
+    return float(np.clip(1.0 - kept / full[on], 0.0, 1.0).max())
 
 
 def _orthonormal_block(X, V, M0, tol, limit):  # noqa: ANN001, ANN202, N803
     """M₀-orthonormalise the columns of X against V and among themselves, dropping the
-    directions below ``tol`` (relative); at most ``limit`` columns."""
+    directions below ``tol`` (relative); at most ``limit`` columns. Returns the block and the
+    number of directions above ``tol`` that ``limit`` dropped."""
     # each load pattern counts alike whatever its units: scale the columns to unit M₀-norm
     norms = np.sqrt(np.einsum("ij,ij->j", X, M0 @ X))
     X = X[:, norms > 0] / norms[norms > 0]
@@ -189,9 +226,10 @@ def _orthonormal_block(X, V, M0, tol, limit):  # noqa: ANN001, ANN202, N803
     G = X.T @ (M0 @ X)
     lam, Q = np.linalg.eigh(0.5 * (G + G.T))
     keep = lam > (tol * ref) ** 2
+    over = max(int(np.count_nonzero(keep)) - limit, 0)
     lam, Q = lam[keep][::-1][:limit], Q[:, keep][:, ::-1][:, :limit]
     Y = (X @ Q) / np.sqrt(lam)
     if V.shape[1] and Y.shape[1]:  # one more pass against V for round-off
         Y = Y - V @ (V.T @ (M0 @ Y))
         Y = Y / np.sqrt(np.einsum("ij,ij->j", Y, M0 @ Y))
-    return Y
+    return Y, over
