@@ -170,6 +170,6 @@ def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa:
 
     kw.setdefault("save_every", None)
     hist = simulate_local_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
-                         on_chunk=on_chunk, keep_coordinates=True, **kw)
+                               on_chunk=on_chunk, keep_coordinates=True, **kw)
     return RackRun(peak_sliding=peak, level_peak=level_peak,
                    falls=tracker.falls() if tracker is not None else [], history=hist)

@@ -113,8 +113,8 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
     return b
 
 
-def simulate_local_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=None,  # noqa: ANN001, ANN201
-                  basis=None, **kw):  # noqa: ANN001, ANN003
+def simulate_local_rack(model, ground: np.ndarray, dt: float, *,  # noqa: ANN001, ANN201
+                        vertical_accel=None, basis=None, **kw):  # noqa: ANN001, ANN003
     """:func:`~seisrack.dynamics.local.simulate_local` on a compiled rack: ``ground`` (n_t,
     n_dir) the down-aisle (and, 3D, cross-aisle) accelerations [m/s²] on the analysis grid;
     other keywords as ``simulate_local``."""
@@ -123,8 +123,9 @@ def simulate_local_rack(model, ground: np.ndarray, dt: float, *, vertical_accel=
     infl = np.array(model.influence)
     if basis is None:
         basis = rack_basis(model, vertical=vertical_accel is not None)
-    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse, local_rack_sliders(model),
-                          dt=dt, ground=np.reshape(ground, (np.shape(ground)[0], -1)),
+    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse,
+                          local_rack_sliders(model), dt=dt,
+                          ground=np.reshape(ground, (np.shape(ground)[0], -1)),
                           influence=infl, vertical_accel=vertical_accel,
                           vertical_influence=None if vertical_accel is None else model.r_y,
                           g=model.g, basis=basis, **kw)
