@@ -69,6 +69,48 @@ def _btd_factor(Hd, Ho, sizes, Ld, X):
 
 
 @_JIT
+def _btd_condensed(Hd, Ho, sizes, X, Rb, Yb, Le):
+    """Cholesky factors ``Le[s]`` of ``E_s = ((H⁻¹)_ss)⁻¹ = H_ss − X_(s−1)ᵀ X_(s−1) −
+    Y_sᵀ Y_s``: slice s's block with both sides condensed, the left from the forward factor
+    (``X`` of :func:`_btd_factor`), the right from a backward one (``Rb[s]`` = chol of the
+    right-condensed ``T_s``, ``Yb[s] = Rb[s+1]⁻¹ H_(s+1, s)``). ``P (Le Leᵀ)⁻¹ Pᵀ`` is then
+    the exact compliance of slice s's DOFs (theory §4.1). Cost about that of one factor.
+    False if a block is not positive definite."""
+    ns = sizes.shape[0]
+    for s in range(ns - 1, -1, -1):
+        b = sizes[s]
+        R = Rb[s]
+        for i in range(b):
+            for k in range(i + 1):
+                R[i, k] = Hd[s, i, k]
+        if s + 1 < ns:
+            _syrk_corner(R, b, Yb[s], sizes[s + 1])
+        if not _potrf_corner(R, b):
+            return False
+        if s > 0:
+            bp = sizes[s - 1]
+            Y = Yb[s - 1]
+            for i in range(b):
+                for c in range(bp):
+                    Y[i, c] = Ho[s - 1, c, i]
+            # Y_(s−1) = R_s⁻¹ H_(s, s−1)
+            _trsm_corner(R, b, Y, bp)
+    for s in range(ns):
+        b = sizes[s]
+        E = Le[s]
+        for i in range(b):
+            for k in range(i + 1):
+                E[i, k] = Hd[s, i, k]
+        if s > 0:
+            _syrk_corner(E, b, X[s - 1], sizes[s - 1])
+        if s + 1 < ns:
+            _syrk_corner(E, b, Yb[s], sizes[s + 1])
+        if not _potrf_corner(E, b):
+            return False
+    return True
+
+
+@_JIT
 def _btd_solve(Ld, X, sizes, offsets, x):
     """x = (L Lᵀ)⁻¹ x in place (x (size,))."""
     ns = sizes.shape[0]

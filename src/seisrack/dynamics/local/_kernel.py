@@ -16,6 +16,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
     from seisrack.dynamics.local._btd import (
         _JIT,
         _btd_combine,
+        _btd_condensed,
         _btd_factor,
         _btd_matvec,
         _btd_solve,
@@ -111,7 +112,8 @@ def _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd):
 
 @_JIT
 def _own_compliance(Ld, P, p, s, b, nd, Dp, t1, t2):
-    """G_p = P_p H_{−p}⁻¹ P_pᵀ with the slice's left-condensed block L_ss L_ssᵀ for H (§4.1):
+    """G_p = P_p H_{−p}⁻¹ P_pᵀ from slice s's block with both sides condensed, L_ss L_ssᵀ =
+    ((H⁻¹)_ss)⁻¹ (``_btd_condensed``, §4.1):
     g = P (L Lᵀ)⁻¹ Pᵀ, then the pallet's own D removed, G = (g⁻¹ − D)⁻¹. Returns g11, g12,
     g22."""
     for i in range(b):
@@ -232,6 +234,10 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
     X = np.zeros_like(Mo)
     Ld2 = np.zeros_like(Md)
     X2 = np.zeros_like(Mo)
+    # the pallets' compliances read both sides of their slice condensed (_btd_condensed)
+    Le = np.zeros_like(Md)
+    Rb = np.zeros_like(Md)
+    Yb = np.zeros_like(Md)
     Dn = np.zeros((m, 4))
     jlast = jerk[:, 2:]  # the last difference of beta (stored beside the jerk)
     rhs = np.empty(N)
@@ -314,13 +320,15 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
         if not _btd_factor(Hd, Ho, sizes, Ld, X):
             status = STATUS_NOT_PD
             break
+        if not _btd_condensed(Hd, Ho, sizes, X, Rb, Yb, Le):
+            Le[:] = Ld  # not reached for a positive definite H; the left side only
         stamp = k + 1
         # predictor: the last step's Δv
         for i in range(N):
             dv[i] = dvp[i]
         _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
                       agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                      Gc, gstamp, stamp, Ld, Dp, outs, ev,
+                      Gc, gstamp, stamp, Le, Dp, outs, ev,
                       t1, t2, stats, False)
         _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
         vscale = 1e-300
@@ -339,7 +347,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
                               agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
                               Gc, gstamp, stamp,
-                              Ld, Dp, outs, ev, t1, t2, stats, True)
+                              Le, Dp, outs, ev, t1, t2, stats, True)
                 for attempt in range(2):
                     for p in range(m):
                         for c in range(4):
@@ -376,7 +384,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 tmp[i] = dv[i] + dlt[i]
             _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
                           agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                          Gc, gstamp, stamp, Ld,
+                          Gc, gstamp, stamp, Le,
                           Dp, outs_n, ev, t1, t2, stats, False)
             _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
             g1 = 0.0
@@ -398,7 +406,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                     _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0,
                                   Nk1, agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
                                   Gc, gstamp,
-                                  stamp, Ld, Dp, outs_n, ev, t1, t2, stats, False)
+                                  stamp, Le, Dp, outs_n, ev, t1, t2, stats, False)
                     _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
                     ga = 0.0
                     for i in range(N):
@@ -453,7 +461,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
                               agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
                               Gc, gstamp, stamp,
-                              Ld, Dp, outs_n, ev, t1, t2, stats, False)
+                              Le, Dp, outs_n, ev, t1, t2, stats, False)
                 for p in range(m):
                     dj = abs(outs_n[p, 0] - outs[p, 0]) + abs(outs_n[p, 1] - outs[p, 1])
                     if dj > 1e-4 * (abs(outs[p, 0]) + abs(outs[p, 1]) + mass[p] * h):
@@ -471,7 +479,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
                               agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
                               Gc, gstamp, stamp,
-                              Ld, Dp, outs, ev, t1, t2, stats, False)
+                              Le, Dp, outs, ev, t1, t2, stats, False)
                 _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
         if not converged:
             # still moving after _NEWTON_MAX iterations (a linear contraction near a pallet's

@@ -278,7 +278,7 @@ def simulate_local(
 def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis) -> int:
     """Bytes the run's kept histories, chunk buffers and kernel work arrays take."""
     per_row = 8 * (2 * nq + 6 * m + 5) + m
-    work = 8 * (10 * basis.n_slices * basis.bmax**2 + 12 * basis.size + 40 * m
+    work = 8 * (13 * basis.n_slices * basis.bmax**2 + 12 * basis.size + 40 * m
                 + 2 * m * basis.bmax)
     return n_keep * (per_row + 8 * m) + (chunk + 1) * per_row + work
 
