@@ -67,7 +67,8 @@ def run_planar_scheme(
     """Integrate the checked inputs of :func:`seisrack.dynamics.simulate` for sliders in the
     plane: ``ag`` (n_t, 2) ground accelerations along x and z with their influence vectors
     ``influence`` (n, 2) (a zero column: no load in that direction), ``av``/``rv`` the
-    vertical motion. Damping must be classical in the basis (Rayleigh or modal). ``hinges``:
+    vertical motion. Damping: any symmetric C, taken as Φᵀ C Φ in the basis (its off-diagonal
+    part costs an (r, r) product per Newton iteration; none when it is diagonal). ``hinges``:
     rotational springs of K whose moment follows a hysteresis law (§7 of the theory page)."""
     if hinges is None:
         hinges = no_hinges()
@@ -91,13 +92,7 @@ def run_planar_scheme(
     n_keep = _kept_samples(n_steps, save_every)
     nh = hinges.count if hinges.nonlinear else 0
     _check_memory(n_keep, chunk, nb, 4 * m + nh, n_t, max_memory)
-    cq = phi.T @ (C @ phi)
-    off = cq - np.diag(np.diag(cq))
-    if np.max(np.abs(off), initial=0.0) > 1e-8 * max(np.max(np.abs(np.diag(cq))), 1e-300):
-        raise InputError("C", "non-classical damping",
-                         "damping that is diagonal in the modes (Rayleigh or modal) for the "
-                         "planar engine")
-    cd = np.ascontiguousarray(np.diag(cq))
+    cd, Co = _reduced_damping(phi, C)
     pat = -(phi.T @ pat_phys)  # (nb, k): modal load per unit of each series
     ser = np.column_stack(series) if series else np.zeros((n_t, 0))
     gz = g + (av if av is not None else np.zeros(n_t))
@@ -144,7 +139,7 @@ def run_planar_scheme(
             outs = tuple(b[:k] for b in bufs)
             left = max(int(max_events) - n_ev, 0)
             st, ne, ns, kd_done = mod.run_planar(
-                kd, cd, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
+                kd, cd, Co, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
                 _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
                 stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8])
@@ -196,6 +191,23 @@ def run_planar_scheme(
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
                       (int(x) for x in stats), strict=True)),
         hinge_moment=khm, hinge_operator=Q, hinge_rotation0=h_th0)
+
+
+def _reduced_damping(phi: np.ndarray, C) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001, N803
+    """(cd, Co): the diagonal of Φᵀ C Φ and its off-diagonal part, or an empty (0, 0) ``Co``
+    when that part is round-off (classical damping: Rayleigh in the modes of K). InputError
+    for a C that is not symmetric (the step's Newton matrix must be)."""
+    cq = phi.T @ (C @ phi)
+    scale = max(np.max(np.abs(cq), initial=0.0), 1e-300)
+    if np.max(np.abs(cq - cq.T), initial=0.0) > 1e-8 * scale:
+        raise InputError("C", "a damping matrix that is not symmetric",
+                         "a symmetric damping matrix C for the planar engine")
+    cq = 0.5 * (cq + cq.T)
+    cd = np.ascontiguousarray(np.diag(cq))
+    off = cq - np.diag(cd)
+    if np.max(np.abs(off), initial=0.0) <= 1e-8 * max(np.max(np.abs(cd), initial=0.0), 1e-300):
+        return cd, np.zeros((0, 0))
+    return cd, np.ascontiguousarray(off)
 
 
 def _keep_index(n_steps: int, save_every: int | None) -> np.ndarray:

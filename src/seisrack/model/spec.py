@@ -29,6 +29,10 @@ RIGID = math.inf
 PINNED = 0.0
 
 DampingKind = Literal["stiffness", "rayleigh", "none"]
+#: the stiffness in the a1 term of the damping: K_E (the elastic stiffness, OpenSees' betaKinit)
+#: or K_E + K_G (with the geometric stiffness of P-Δ); the same without P-Δ
+StiffnessTerm = Literal["elastic", "with_p_delta"]
+STIFFNESS_TERMS = ("elastic", "with_p_delta")
 
 
 @dataclass(frozen=True)
@@ -163,12 +167,19 @@ class Damping:
       ``"first"``, at the first period of the frame with the pallets rigidly attached.
     - ``kind="rayleigh"``: C = a0·M + a1·K through the two ``(period [s], ratio)`` ``pairs``.
     - ``kind="none"``: C = 0.
+
+    ``stiffness_term``: which K the a1 term uses when ``[second_order] p_delta`` adds the
+    geometric stiffness K_G: ``"elastic"`` (default) K_E, the elastic stiffness of the members
+    and connections (OpenSees' ``rayleigh`` with betaKinit: its initial stiffness has no
+    geometric term; the usual reading of the codes), or ``"with_p_delta"`` K_E + K_G. Without
+    P-Δ both are the same matrix. ``period = "first"`` is the first period of K_E + K_G in both.
     """
 
     kind: DampingKind = "none"
     ratio: float = 0.0
     period: float | Literal["first"] = "first"
     pairs: tuple[tuple[float, float], ...] = ()
+    stiffness_term: StiffnessTerm = "elastic"
 
 
 @dataclass(frozen=True)
