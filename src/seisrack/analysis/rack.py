@@ -136,6 +136,13 @@ def run_rack(
     mot = ground_motion(model, motion, vertical)
     if method == "exact":
         require("exact modal propagators (method exact)", model.ndm, "method", method)
+        if non_classical_damping(model):
+            raise InputError(
+                "method", method, '"newmark" or "auto" for this rack',
+                hint="With P-Δ, damping a1·K_E ([damping] stiffness_term = \"elastic\", the "
+                     "default) is not classical in the modes of K_E + K_G, which the exact "
+                     "propagators need. Use method \"auto\" (Newmark here), or "
+                     "stiffness_term = \"with_p_delta\" (a1·(K_E + K_G)) for exact propagators")
     check_engine(engine, model, method=method, basis=basis)
     k = analysis_grid(mot, dt)
     h = mot.dt / k
@@ -166,7 +173,8 @@ def run_rack(
     # or when the damping has a mass term
     newmark = not line or method == "newmark" or hinges is not None or (
         sliders.velocity_dependent) or (
-        method == "auto" and model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
+        method == "auto" and ((model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
+                              or non_classical_damping(model)))
     tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
     contacts = ContactTracker(model.layout, model.n_pallets)
@@ -328,3 +336,11 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
         impacts=tuple(contacts.impacts()),
         pallet_row=np.asarray(model.pallet_row) if model.n_rows > 1 else None,
     )
+
+
+def non_classical_damping(model: FrameModel) -> bool:
+    """True when the rack's C is not diagonal in the modes of its K: C = a0·M + a1·K_E with
+    P-Δ in K ([damping] ``stiffness_term = "elastic"``). The exact propagators then do not
+    apply and the engine takes Newmark."""
+    return (model.critical_load_factor is not None and model.damping_coefficients[1] != 0.0
+            and model.damping_stiffness_term == "elastic")
