@@ -98,7 +98,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     that goes with ``A``; ``out_hm`` (n_t, n_h) their moments. Energy (cumulative from the
     start of the run, resumed from ``e_state``: input, damping, friction, the hinges'
     correction work ∫ z dθ): ``out_energy`` (n_t, 5) columns input, kinetic, strain (with the
-    hinges' correction work), damping, friction.
+    hinges' correction work), damping, friction; ``out_energy`` with no columns (n_t, 0): the
+    energy terms are not computed (nobody reads them: a study's runs).
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -150,6 +151,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     dqe = np.empty(r)
     ena = np.empty(2)
     E_in, E_damp, E_fric, E_z = e_state[0], e_state[1], e_state[2], e_state[3]
+    track = out_energy.shape[1] > 0
     if not resume:
         E_in, E_damp, E_fric, E_z = 0.0, 0.0, 0.0, 0.0
         # pallets start stuck, moving with their supports
@@ -179,7 +181,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
         _fill_relative(P, T0, S0)
     _output(0, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck)
     out_hm[0, :] = hM
-    _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+    if track:
+        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
     k_done = 0
     n_tr = np.zeros(m, dtype=np.int64)
     frozen = np.zeros(m, dtype=np.bool_)
@@ -269,26 +272,29 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                 th_hi = _bracket_end(br, T1, S1, Tb, Sb)
             # the work over the accepted sub-step [tau, tau_end] (Newmark's energy identity:
             # forces averaged over its two ends, which is exact for the trapezoidal rule)
-            tau_e = _substep_end(tau, th_hi, any_ev)
-            _sample_row(pext, k, tau, pea)
-            _sample_row(pext, k, tau_e, peb)
-            ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau) + _interp(agx[k], agx[k + 1], tau_e))
-            ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau) + _interp(agz[k], agz[k + 1], tau_e))
-            for i in range(r):
-                dqe[i] = T1[0, i] - T0[0, i]
-                E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
-                E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
-            if Co.shape[0] > 0:  # the off-diagonal damping: dqᵀ Co (qd0 + qd1) / 2
+            if track:
+                tau_e = _substep_end(tau, th_hi, any_ev)
+                _sample_row(pext, k, tau, pea)
+                _sample_row(pext, k, tau_e, peb)
+                ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau)
+                                + _interp(agx[k], agx[k + 1], tau_e))
+                ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau)
+                                + _interp(agz[k], agz[k + 1], tau_e))
                 for i in range(r):
-                    pea[i] = 0.5 * (T0[1, i] + T1[1, i])
-                E_damp += np.dot(dqe, np.dot(Co, pea))
-            vrel = np.dot(P, dqe)
-            for p in range(m):
-                for c in range(2):
-                    j = 2 * p + c
-                    dw = S1[0, j] - S0[0, j]
-                    E_in -= mass[p] * dw * ena[c]
-                    E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
+                    dqe[i] = T1[0, i] - T0[0, i]
+                    E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
+                    E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
+                if Co.shape[0] > 0:  # the off-diagonal damping: dqᵀ Co (qd0 + qd1) / 2
+                    for i in range(r):
+                        pea[i] = 0.5 * (T0[1, i] + T1[1, i])
+                    E_damp += np.dot(dqe, np.dot(Co, pea))
+                vrel = np.dot(P, dqe)
+                for p in range(m):
+                    for c in range(2):
+                        j = 2 * p + c
+                        dw = S1[0, j] - S0[0, j]
+                        E_in -= mass[p] * dw * ena[c]
+                        E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
             T0[:] = T1
             S0[:] = S1
             if nh > 0:
@@ -333,7 +339,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
         _output(k + 1, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam,
                 out_stuck)
         out_hm[k + 1, :] = hM
-        _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+        if track:
+            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
         k_done = k + 1
         if not np.isfinite(T0[0, 0]):
             status = STATUS_NONFINITE

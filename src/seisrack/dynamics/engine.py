@@ -191,7 +191,7 @@ def simulate(
         chunk = min(int(chunk_steps or (1000 if progress is not None else 5000)), n_steps)
         return run_planar_scheme(M, C, K, sliders, ag=ag, influence=infl, chunk=chunk,
                                  max_events=500_000 if max_events is None else max_events,
-                                 hinges=hinges, **common)
+                                 hinges=hinges, track_energy=track_energy, **common)
     ag = np.zeros(n_t) if ground_accel is None else chk.series(
         "ground_accel", _one_column(ground_accel), (n_t,))
     r = np.ones(n) if influence is None else chk.series("influence", _one_column(influence),
