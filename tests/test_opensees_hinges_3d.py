@@ -52,7 +52,8 @@ split on the supports; the two differ when the front and rear beams move differe
 cross-aisle bending of the frames): the moment histories of the cross-aisle base plates differ
 by 3.4 % of their peak in both cases, their peaks by 0.2 % at most. With P-Δ and both
 directions (c) the connectors' moment histories differ by up to 4 % of their peak, 0.4 % in
-(a).
+(a), 0.92 % in (b) (there the down-aisle base plates' by 12.8 %: at My = 60 N·m they switch
+between ±My, and the switching instants differ).
 """
 
 from __future__ import annotations
@@ -199,4 +200,8 @@ def test_peak_hinge_moments_within_2_percent(pair) -> None:
     # (not only the magnitudes), within the model difference of the rigid pallets above
     hist = np.abs(ms - mo).max(axis=0) / np.abs(mo).max(axis=0)
     conn = np.array([h.startswith("connector") for h in labels])
-    assert hist[conn].max() < 0.05 and hist[~conn].max() < 0.1, hist
+    # down-aisle only (b): the 60 N·m base plates sit at ±My most of the time and their
+    # histories differ at the instants they switch (measured 12.8 % of their peak there;
+    # connectors 0.92 %)
+    base_tol = 0.1 if CASES[case][2] else 0.15
+    assert hist[conn].max() < 0.05 and hist[~conn].max() < base_tol, hist
