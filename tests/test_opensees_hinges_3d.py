@@ -1,6 +1,6 @@
 """Nonlinear connections and P-Δ on a 3D rack against OpenSees (issue 21: the last item of
-"every command on a 3D rack"): the 3D paper rack shaken in both horizontal directions into
-yielding, seisrack vs OpenSeesPy.
+"every command on a 3D rack"): the 3D paper rack shaken into yielding (in both horizontal
+directions, or down-aisle only), seisrack vs OpenSeesPy.
 
 Reference: OpenSeesPy (3.7.1 when written) running the script of ``seisrack export opensees``
 for the same compiled 3D rack with ``hysteresis=spec.hysteresis``: 6 DOF per node,
@@ -13,8 +13,9 @@ seisrack's ``[second_order] p_delta = true, form = "p_delta_only"`` (the same ch
 ``tests/test_fe_pdelta_3d.py``), gravity applied first (``gravity()``, a static step held
 constant), pallets rigid (OpenSees: their masses on their supports; seisrack:
 ``with_friction(spec, 1e6)``, no pallet slides), Newmark average acceleration with Newton
-(NormDispIncr 1e-10), the same dt = 5 ms, damping C = a1 K_initial. Ground motion: El Centro
-1940 N-S × 1.5 down-aisle and the same record 4 s later × 1.5 cross-aisle, 30 s, then 30 s of
+(NormDispIncr 1e-10), the same dt = 5 ms, damping C = a1 K_initial (= a1 K_E). Ground
+motion: El Centro 1940 N-S × 1.5 down-aisle and the same record 4 s later × 1.5 cross-aisle
+(not in case (b)), 30 s, then 30 s of
 free vibration (20 s did not settle the elastic-plastic rack: 5.3 % of its drift in the last
 2 s); both programs interpolate the 10 ms record linearly.
 
@@ -23,27 +24,36 @@ the residual down-aisle drift (the mean of the last 2 s, settled), and the peak 
 connector; the base plates' peak moments too, and a cross-aisle base plate must yield (the
 cross-aisle ground motion bends the base plates about x past their yield).
 
-The laws: (a) elastic-perfectly plastic connectors (My 2.5 kN·m) and base plates (My 60 N·m:
-the base plates are all but pinned down-aisle, and yield cross-aisle too), P-Δ off. With P-Δ
-the residual drift of such a rack (a flat post-yield branch: P-Δ makes it ratchet) was
-measured 15.6 % off (4.1 % with base plates of 1 kN·m), its peak displacement within 0.25 %
-(one connector's peak moment 3.8 % off with the 60 N·m base plates): seisrack's
-damping is a1 K with the geometric stiffness in K, OpenSees' a1 K_initial without it, and the
-ratchet magnifies that (on the 2D paper rack with EPP hinges and P-Δ: residual drift 0.59 %
-off with seisrack's C, 0.09 % with C = a1 K_E, which the planar scheme cannot take: it needs
-damping that is classical in its basis). So case (a) runs with P-Δ off and case (b) with it.
-(b) the pinched law without damage on the connectors (asymmetric, as in
-``tests/test_opensees_hinges.py``) and a hardening pinched envelope on the base plates
-(yield at 0.3 mrad, 48 N·m, then 0.7, 1.8, 2.6 kN·m at 5, 15, 40 mrad), so that the base
-plates yield about both axes while the rack keeps its down-aisle base stiffness: with P-Δ.
+The cases: (a) elastic-perfectly plastic connectors (My 2.5 kN·m) and base plates (My 60 N·m:
+the base plates are all but pinned down-aisle, and yield cross-aisle too), P-Δ off, both
+directions. (b) the same laws WITH P-Δ, down-aisle motion only, the damping
+C = a1 K_E on both sides (seisrack's ``[damping] stiffness_term = "elastic"``, set here;
+OpenSees' betaKinit: ``PDeltaCrdTransf3d::getInitialGlobalStiffMatrix`` leaves the geometric
+N/L terms out of the initial stiffness). Measured (OpenSeesPy 3.7.1): peak −0.010 %, residual
+drift +0.12 % (3.085 mm vs 3.081 mm, peak 100 mm), connector peak moments within 0.10 %; with
+``stiffness_term = "with_p_delta"`` (a1 (K_E + K_G), seisrack's default) the
+residual drift is −5.7 % off. With BOTH directions the EPP + P-Δ rack is not compared: its
+residual drift differs by 22.6 % (a1 K_E) or 15.6 % (a1 (K_E + K_G)), and by 26 % with no
+damping at all (seisrack −11.4 mm, OpenSees −15.5 mm, peaks within 0.7 %), so the gap is a
+model difference, not the damping: in seisrack the down-aisle drift of this symmetric rack
+is the same with or without the cross-aisle motion (3.084 vs 3.085 mm), in OpenSees the
+cross-aisle motion moves it from 3.081 to 2.515 mm. Not established which difference couples
+them there: OpenSees' PDelta transformation takes each member's current axial force (the
+cross-aisle overturning changes the uprights' forces), seisrack's K_G the gravity forces,
+and the rigid pallets differ (below). (c) the pinched law without damage on the connectors
+(asymmetric, as in ``tests/test_opensees_hinges.py``) and a hardening pinched envelope on the
+base plates (yield at 0.3 mrad, 48 N·m, then 0.7, 1.8, 2.6 kN·m at 5, 15, 40 mrad), so that
+the base plates yield about both axes while the rack keeps its down-aisle base stiffness:
+with P-Δ, both directions.
 
 Differences that remain are model differences, not the integration: a rigid pallet in
 seisrack moves with the mean of its supports (a mass on the mean), in OpenSees its mass is
 split on the supports; the two differ when the front and rear beams move differently (in
 cross-aisle bending of the frames): the moment histories of the cross-aisle base plates differ
-by 3.4 % of their peak in both cases, their peaks by 0.2 % at most. With P-Δ (b) the damping
-convention above adds to it: the connectors' moment histories differ by up to 4 % of their
-peak in (b), 0.4 % in (a).
+by 3.4 % of their peak in both cases, their peaks by 0.2 % at most. With P-Δ and both
+directions (c) the connectors' moment histories differ by up to 4 % of their peak, 0.4 % in
+(a), 0.92 % in (b) (there the down-aisle base plates' by 12.8 %: at My = 60 N·m they switch
+between ±My, and the switching instants differ).
 """
 
 from __future__ import annotations
@@ -72,10 +82,12 @@ SCALE = 1.5
 FREE_VIBRATION = 30.0
 TOL = 0.02  # issue 21
 
+_EPP = Hysteresis(HingeLaw("elastic-plastic", K_CONNECTION, yield_moment=2500.0),
+                  HingeLaw("elastic-plastic", K_CONNECTION, yield_moment=60.0))
+#: case -> (laws, P-Δ, cross-aisle component)
 CASES = {
-    "elastic-plastic": (Hysteresis(
-        HingeLaw("elastic-plastic", K_CONNECTION, yield_moment=2500.0),
-        HingeLaw("elastic-plastic", K_CONNECTION, yield_moment=60.0)), False),
+    "elastic-plastic": (_EPP, False, True),
+    "elastic-plastic-p-delta-down-aisle": (_EPP, True, False),
     "pinching": (Hysteresis(
         HingeLaw("pinching", K_CONNECTION, envelope_rotation=(0.01, 0.03, 0.06, 0.10),
                  envelope_moment=(1600.0, 2400.0, 2800.0, 3000.0),
@@ -87,27 +99,30 @@ CASES = {
         HingeLaw("pinching", K_CONNECTION, envelope_rotation=(0.0003, 0.005, 0.015, 0.04),
                  envelope_moment=(48.0, 700.0, 1800.0, 2600.0),
                  reload_rotation_ratio=0.3, reload_moment_ratio=0.2, unload_moment_ratio=0.05)),
-        True),
+        True, True),
 }
 
 
 def rack_spec(case: str):
     """The 3D paper rack with the case's laws, rigid pallets, P-Δ (chord form) on or off."""
-    laws, p_delta = CASES[case]
+    laws, p_delta, _cross = CASES[case]
     spec = with_friction(load_rack(RACK), 1e6)
+    # OpenSees' rayleigh with betaKinit: a1 K_E (the default is a1 (K_E + K_G))
     return replace(spec, hysteresis=laws, second_order=replace(
-        spec.second_order, p_delta=p_delta, form="p_delta_only"))
+        spec.second_order, p_delta=p_delta, form="p_delta_only"),
+        damping=replace(spec.damping, stiffness_term="elastic"))
 
 
-def components() -> tuple[np.ndarray, np.ndarray, float]:
+def components(case: str) -> tuple[np.ndarray, np.ndarray, float]:
     rec = load_builtin_record("elcentro_1940_ns")
     n = int(round(SECONDS / rec.dt)) + 1
     s = int(round(SHIFT / rec.dt))
-    return SCALE * rec.accel[:n], SCALE * rec.accel[s:s + n], rec.dt
+    cross = CASES[case][2]
+    return SCALE * rec.accel[:n], SCALE * rec.accel[s:s + n] * cross, rec.dt
 
 
-def opensees_history(model, spec) -> dict[str, np.ndarray]:
-    ax, az, dt_rec = components()
+def opensees_history(model, spec, case: str) -> dict[str, np.ndarray]:
+    ax, az, dt_rec = components(case)
     ns: dict = {"__name__": "rack_ops"}
     exec(compile(opensees_script(model, pallets="rigid", hysteresis=spec.hysteresis),
                  "rack_ops.py", "exec"), ns)
@@ -128,10 +143,10 @@ def pair(request):
     pytest.importorskip("openseespy.opensees")
     spec = rack_spec(request.param)
     model = compile_rack(spec)
-    ax, az, dt_rec = components()
+    ax, az, dt_rec = components(request.param)
     res = run_rack(model, combine(Record(ax, dt_rec, "x"), Record(az, dt_rec, "z")), dt=DT,
                    free_vibration=FREE_VIBRATION)
-    return request.param, res, opensees_history(model, spec)
+    return request.param, res, opensees_history(model, spec, request.param)
 
 
 def _settled(d: np.ndarray) -> float:
@@ -148,13 +163,14 @@ def test_same_grid_no_sliding_and_yielding_both_ways(pair) -> None:
     np.testing.assert_allclose(ops["t"], res.t, atol=1e-9)
     peaks = {p["hinge"]: p for p in res.hinges.peaks()}
     assert max(p["ductility"] for h, p in peaks.items() if h.startswith("connector")) > 1.5
-    assert any(p["yielded"] for h, p in peaks.items() if h.endswith("cross-aisle")), case
+    if CASES[case][2]:
+        assert any(p["yielded"] for h, p in peaks.items() if h.endswith("cross-aisle")), case
 
 
 @pytest.mark.slow
 def test_peak_displacements_within_2_percent(pair) -> None:
     case, res, ops = pair
-    for d, key in enumerate(("level_displacement", "level_displacement_z")):
+    for d, key in enumerate(("level_displacement", "level_displacement_z")[:1 + CASES[case][2]]):
         s = np.abs(res.beam_displacement[:, 0, d]).max()
         o = np.abs(ops[key][:, 0]).max()
         assert abs(s / o - 1) < TOL, f"{case}, direction {d}: seisrack {s:.6f}, OpenSees {o:.6f}"
@@ -176,10 +192,18 @@ def test_peak_hinge_moments_within_2_percent(pair) -> None:
     case, res, ops = pair
     ms, mo = res.hinges.moment, ops["spring_force"]
     assert ms.shape == mo.shape
+    # the hinges that the motion loads (down-aisle only: not the cross-aisle base plates)
+    on = np.abs(mo).max(axis=0) > 1e-3 * np.abs(mo).max()
+    ms, mo = ms[:, on], mo[:, on]
+    labels = [h for h, x in zip(res.hinges.labels, on, strict=True) if x]
     err = np.abs(np.abs(ms).max(axis=0) / np.abs(mo).max(axis=0) - 1)
-    assert err.max() < TOL, f"{case}: {dict(zip(res.hinges.labels, err.round(5), strict=True))}"
+    assert err.max() < TOL, f"{case}: {dict(zip(labels, err.round(5), strict=True))}"
     # the sign convention of the rotational zeroLength about rx and rz: the histories agree
     # (not only the magnitudes), within the model difference of the rigid pallets above
     hist = np.abs(ms - mo).max(axis=0) / np.abs(mo).max(axis=0)
-    conn = np.array([h.startswith("connector") for h in res.hinges.labels])
-    assert hist[conn].max() < 0.05 and hist[~conn].max() < 0.1, hist
+    conn = np.array([h.startswith("connector") for h in labels])
+    # down-aisle only (b): the 60 N·m base plates sit at ±My most of the time and their
+    # histories differ at the instants they switch (measured 12.8 % of their peak there;
+    # connectors 0.92 %)
+    base_tol = 0.1 if CASES[case][2] else 0.15
+    assert hist[conn].max() < 0.05 and hist[~conn].max() < base_tol, hist

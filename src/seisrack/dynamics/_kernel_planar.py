@@ -69,7 +69,7 @@ _SPAN = 1e-6
 
 
 @_JIT
-def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state, S_state,
+def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state, S_state,
                stuck, dirn, S, A, fac, t_offset, max_events, max_substeps,
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
                ev_time, ev_pallet, ev_kind, stats,
@@ -77,6 +77,9 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     """Integrate ``agx.shape[0] - 1`` steps. Returns (status, n_events, n_substeps, the last
     output row written).
 
+    kd, cd: (r,) the stiffness and the damping's diagonal in the basis; ``Co`` (r, r) the
+    damping's off-diagonal part (non-classical damping, e.g. a1 K_E in the modes of
+    K_E + K_G), or (0, 0) when it is diagonal: the diagonal path then runs as before.
     agx, agz: (n_t,) ground accelerations down-aisle (x) and cross-aisle (z); pext: (n_t, r)
     modal loads; N: (n_t, m) normal forces. The state is read when ``resume`` (else the
     pallets start stuck on a structure at the given q, qd) and written back at the end, so
@@ -95,7 +98,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     that goes with ``A``; ``out_hm`` (n_t, n_h) their moments. Energy (cumulative from the
     start of the run, resumed from ``e_state``: input, damping, friction, the hinges'
     correction work ∫ z dθ): ``out_energy`` (n_t, 5) columns input, kinetic, strain (with the
-    hinges' correction work), damping, friction.
+    hinges' correction work), damping, friction; ``out_energy`` with no columns (n_t, 0): the
+    energy terms are not computed (nobody reads them: a study's runs).
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -147,6 +151,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
     dqe = np.empty(r)
     ena = np.empty(2)
     E_in, E_damp, E_fric, E_z = e_state[0], e_state[1], e_state[2], e_state[3]
+    track = out_energy.shape[1] > 0
     if not resume:
         E_in, E_damp, E_fric, E_z = 0.0, 0.0, 0.0, 0.0
         # pallets start stuck, moving with their supports
@@ -166,7 +171,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
         ag[0] = agx[0]
         ag[1] = agz[0]
         _minus_qtz(pext[0], Q, hz, pz)
-        _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pz, N[0], stuck, dirn,
+        _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, N[0], stuck, dirn,
                 cand, forced, A, pe, forced)
         for p in range(m):
             old_stuck[p] = True  # "slip" at t = 0 for pallets released at once
@@ -176,7 +181,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
         _fill_relative(P, T0, S0)
     _output(0, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck)
     out_hm[0, :] = hM
-    _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+    if track:
+        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
     k_done = 0
     n_tr = np.zeros(m, dtype=np.int64)
     frozen = np.zeros(m, dtype=np.bool_)
@@ -194,7 +200,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
             ag[1] = agz[k + 1]
             for i in range(r):
                 dqg[i] = hrem * T0[1, i] + 0.5 * hrem * hrem * T0[2, i]
-            ok = _trial(hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag,
+            ok = _trial(hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag,
                         pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF, stats,
                         dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt, hzt, HW)
             _mask_frozen(frozen, e_hi)
@@ -246,7 +252,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                         for i in range(r):
                             dqg[i] = hs * T0[1, i] + 0.25 * hs * hs * (
                                 2.0 * T0[2, i] + th * (qdd_full[i] - T0[2, i]))
-                    ok = _trial(th * hrem, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck,
+                    ok = _trial(th * hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck,
                                 dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G, PF, stats,
                                 dqg, warm, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt,
                                 hzt, HW)
@@ -266,22 +272,29 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 th_hi = _bracket_end(br, T1, S1, Tb, Sb)
             # the work over the accepted sub-step [tau, tau_end] (Newmark's energy identity:
             # forces averaged over its two ends, which is exact for the trapezoidal rule)
-            tau_e = _substep_end(tau, th_hi, any_ev)
-            _sample_row(pext, k, tau, pea)
-            _sample_row(pext, k, tau_e, peb)
-            ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau) + _interp(agx[k], agx[k + 1], tau_e))
-            ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau) + _interp(agz[k], agz[k + 1], tau_e))
-            for i in range(r):
-                dqe[i] = T1[0, i] - T0[0, i]
-                E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
-                E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
-            vrel = np.dot(P, dqe)
-            for p in range(m):
-                for c in range(2):
-                    j = 2 * p + c
-                    dw = S1[0, j] - S0[0, j]
-                    E_in -= mass[p] * dw * ena[c]
-                    E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
+            if track:
+                tau_e = _substep_end(tau, th_hi, any_ev)
+                _sample_row(pext, k, tau, pea)
+                _sample_row(pext, k, tau_e, peb)
+                ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau)
+                                + _interp(agx[k], agx[k + 1], tau_e))
+                ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau)
+                                + _interp(agz[k], agz[k + 1], tau_e))
+                for i in range(r):
+                    dqe[i] = T1[0, i] - T0[0, i]
+                    E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
+                    E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
+                if Co.shape[0] > 0:  # the off-diagonal damping: dqᵀ Co (qd0 + qd1) / 2
+                    for i in range(r):
+                        pea[i] = 0.5 * (T0[1, i] + T1[1, i])
+                    E_damp += np.dot(dqe, np.dot(Co, pea))
+                vrel = np.dot(P, dqe)
+                for p in range(m):
+                    for c in range(2):
+                        j = 2 * p + c
+                        dw = S1[0, j] - S0[0, j]
+                        E_in -= mass[p] * dw * ena[c]
+                        E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
             T0[:] = T1
             S0[:] = S1
             if nh > 0:
@@ -299,7 +312,7 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
                 _minus_qtz(pe, Q, hz, pz)
-                _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pz, Ne, stuck, dirn,
+                _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, Ne, stuck, dirn,
                         cand, forced, A, W[10, :r], frozen)
                 fac[0] = -1.0
                 for p in range(m):
@@ -326,7 +339,8 @@ def run_planar(kd, cd, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state
         _output(k + 1, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam,
                 out_stuck)
         out_hm[k + 1, :] = hM
-        _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+        if track:
+            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
         k_done = k + 1
         if not np.isfinite(T0[0, 0]):
             status = STATUS_NONFINITE

@@ -64,7 +64,7 @@ def _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P, qdd0, ag0, hre
 
 
 @_JIT
-def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand, forced,
+def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand, forced,
             A, base, frozen):
     """Contact state at an instant and consistent accelerations (active set).
 
@@ -75,7 +75,8 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
     their capacity: when several reach their threshold together, releasing one can unload the
     others (an all-at-once release chattered, each pallet re-sticking at once). Updates
     ``stuck``, ``dirn`` and ``S`` (the stuck pallets' mass); writes qdd, wdd and lam.
-    ``frozen`` pallets keep their state (see ``_CHATTER``).
+    ``frozen`` pallets keep their state (see ``_CHATTER``). Damping: ``cd`` its diagonal,
+    ``Co`` the rest or (0, 0) (see ``_trial``).
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -108,6 +109,8 @@ def _decide(kd, cd, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand
                     fv[j] = -mud[p] * N[p] * dirn[j]
                     lam[j] = fv[j]
         base[:] = pext - cd * qd - kd * q - np.dot(fv, P)
+        if Co.shape[0] > 0:  # non-classical damping: its off-diagonal part
+            base[:] -= np.dot(Co, qd)
         _chol_solve(A, base)
         if n_rel > 0:
             rel = np.empty(n_rel, dtype=np.int64)

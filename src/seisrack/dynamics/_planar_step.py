@@ -66,14 +66,28 @@ def _sample_row(X, step, frac, out):
 
 
 @_JIT
-def _a_lin(A, S, c0, c2, cd, kd):
-    """A = diag(c0 + c2 cd + kd) + c0 S: the step's stiffness with the stuck pallets (its
-    lower triangle, all that :func:`_chol` reads)."""
+def _a_lin(A, S, c0, c2, cd, Co, kd):
+    """A = diag(c0 + c2 cd + kd) + c2 Co + c0 S: the step's stiffness with the stuck pallets
+    (its lower triangle, all that :func:`_chol` reads); ``Co`` the off-diagonal part of the
+    damping, (r, r), or (0, 0) when the damping is diagonal in the basis."""
     r = kd.shape[0]
+    full = Co.shape[0] > 0
     for i in range(r):
         for k in range(i + 1):
             A[i, k] = c0 * S[i, k]
+        if full:
+            for k in range(i):
+                A[i, k] += c2 * Co[i, k]
         A[i, i] += c0 + c2 * cd[i] + kd[i]
+
+
+@_JIT
+def _damp_off(Co, v, out):
+    """out = Co v (0 when the damping is diagonal: ``Co`` is (0, 0))."""
+    if Co.shape[0] > 0:
+        out[:] = np.dot(Co, v)
+    else:
+        out[:] = 0.0
 
 
 @_JIT
@@ -127,7 +141,7 @@ def _huber(yx, yz, cc, mp, h):
 
 
 @_JIT
-def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1, N1,
+def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1, N1,
            T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
            Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW):
     """One Newmark step of length ``h`` with a fixed contact state, from (T0, S0) to (T1, S1).
@@ -143,6 +157,9 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     warm trial within 0.1 % of that length starts with chord steps on it. Returns 0, or 1 when
     the step matrix is not positive definite, 2 when Newton's iteration on the sliding
     directions did not converge. Products with ``P`` and ``S`` go through BLAS.
+
+    Damping: ``cd`` (r,) its diagonal in the basis, ``Co`` (r, r) the rest (zero diagonal), or
+    (0, 0) when it is diagonal (classical): the products with ``Co`` are skipped then.
 
     Nonlinear hinges (n_h = ``hk.shape[0]``, possibly 0): ``Q`` (n_h, r) their rotations of the
     basis coordinates, ``hth0`` the rotations at q = 0, ``hk`` the elastic stiffness in ``kd``,
@@ -168,9 +185,13 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     kfac = HW[3]  # the hinges' k_t − k in the factor held in A (kept across calls, as A is)
     for i in range(nh):
         thb[i] = hth0[i] + np.dot(Q[i], q0)
+    full = Co.shape[0] > 0
+    od = np.empty(r)  # Co dq, updated with the steps of dq as sd (Co qd0 first)
+    _damp_off(Co, qd0, od)
     for i in range(r):
         dg[i] = c0 + c2 * cd[i] + kd[i]
-        rhs[i] = pext1[i] + c1 * qd0[i] + qdd0[i] + cd[i] * qd0[i] - kd[i] * q0[i]
+        rhs[i] = (pext1[i] + c1 * qd0[i] + qdd0[i] + cd[i] * qd0[i] + od[i]
+                  - kd[i] * q0[i])
     # a stuck pallet is a mass on its support: lam = m c0 P dq + beta with
     # beta = m (-2 c2 P qd0 - P qdd0 + ag) (its velocity and acceleration are its support's),
     # so that Σ_stuck P_pᵀ beta_p = -S (2 c2 qd0 + qdd0) + ag_x g_x + ag_z g_z
@@ -211,7 +232,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         # first iterate: the linear step with the friction of the start of the step
         res[:] = rhs - np.dot(lam, PFs)
         _minus_qtz(res, Q, hz_c, res)
-        _a_lin(A, S, c0, c2, cd, kd)
+        _a_lin(A, S, c0, c2, cd, Co, kd)
         stats[2] += 1
         if not _chol(A):
             return 1
@@ -228,10 +249,12 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
     # friction term is a Huber function of y_p): Newton's steps are damped by backtracking on
     # it, which cures the cycling of plain Newton across the disc
     sd = np.empty(r)  # S dq, and pd = PF dq: updated with the steps of dq
+    so = np.empty(r)  # Co times a Newton step
     for _it in range(_NEWTON_MAX if nonlin else 0):
         if _it == 0:
             pd[:] = np.dot(PFs, dq)
             sd[:] = np.dot(Ss, dq)
+            _damp_off(Co, dq, od)
         # the hinges at this iterate: moments, corrections and tangents (th, dth: scratch)
         thsc = 1e-300
         hpot = 0.0
@@ -246,7 +269,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
             thsc = max(thsc, abs(th[i]) + abs(mi) / hk[i])
             hpot += abs(mi) + hk[i] * abs(th[i])
         for i in range(r):
-            rlin[i] = rhs[i] - dg[i] * dq[i] - c0 * sd[i]
+            rlin[i] = rhs[i] - dg[i] * dq[i] - c0 * sd[i] - c2 * od[i]
         ymax = 0.0
         hub0 = 0.0
         ng = 0
@@ -262,7 +285,7 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         res[:] = rlin - np.dot(lam, PFs)
         _minus_qtz(res, Q, hz, res)
         if refac:
-            _a_lin(A, S, c0, c2, cd, kd)
+            _a_lin(A, S, c0, c2, cd, Co, kd)
             _syrk_lower(A, G, ng)
             for i in range(nh):  # the hinges' tangents: Qᵀ diag(k_t − k) Q (lower triangle)
                 d = dth[i]
@@ -285,9 +308,10 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         lin1 = -np.dot(rlin, stp)
         slope = -np.dot(res, stp)
         ss = np.dot(Ss, stp)
+        _damp_off(Co, stp, so)
         lin2 = 0.0
         for i in range(r):
-            lin2 += stp[i] * (dg[i] * stp[i] + c0 * ss[i])
+            lin2 += stp[i] * (dg[i] * stp[i] + c0 * ss[i] + c2 * so[i])
         ps[:] = np.dot(PFs, stp)
         for i in range(nh):
             dth[i] = np.dot(Q[i], stp)
@@ -297,7 +321,8 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         hpot *= hmax
         # and the round-off of lin1: the terms of rlin are far larger than rlin at short steps
         for i in range(r):
-            hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i]))
+            hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i])
+                                   + c2 * abs(od[i]))
         # a full step below the stopping tolerance is taken as it is: backtracking would
         # compare changes of the potential at the level of their round-off (at short
         # steps, where 4/h² magnifies it) and could stop on a damped step short of the root
@@ -327,6 +352,9 @@ def _trial(h, kd, cd, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
         for i in range(r):
             dq[i] += alpha * stp[i]
             sd[i] += alpha * ss[i]
+        if full:
+            for i in range(r):
+                od[i] += alpha * so[i]
         for jf in range(nf):
             pd[jf] += alpha * ps[jf]
             step = max(step, abs(c2 * alpha * ps[jf]))

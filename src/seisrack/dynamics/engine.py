@@ -146,7 +146,7 @@ def simulate(
     if inp.planar:
         return run_planar_scheme(inp.M, inp.C, inp.K, sliders, influence=inp.influence,
                                  max_events=500_000 if max_events is None else max_events,
-                                 **common)
+                                 track_energy=track_energy, **common)
     return run_line(inp.M, inp.C, inp.K, sliders, r=inp.influence, F=inp.F, q_u0=inp.u0,
                     q_v0=inp.v0, track_energy=track_energy, method=method,
                     max_events=200_000 if max_events is None else max_events, **common)

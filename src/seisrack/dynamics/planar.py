@@ -60,12 +60,15 @@ def run_planar_scheme(
     max_events: int,
     throw: bool,
     hinges: Hinges | None = None,
+    track_energy: bool = True,
 ) -> TimeHistory:
     """Integrate the checked inputs of :func:`seisrack.dynamics.simulate` for sliders in the
     plane: ``ag`` (n_t, 2) ground accelerations along x and z with their influence vectors
     ``influence`` (n, 2) (a zero column: no load in that direction), ``av``/``rv`` the
-    vertical motion. Damping must be classical in the basis (Rayleigh or modal). ``hinges``:
-    rotational springs of K whose moment follows a hysteresis law (§7 of the theory page)."""
+    vertical motion. Damping: any symmetric C, taken as Φᵀ C Φ in the basis (its off-diagonal
+    part costs an (r, r) product per Newton iteration; none when it is diagonal). ``hinges``:
+    rotational springs of K whose moment follows a hysteresis law (§7 of the theory page).
+    ``track_energy=False``: no energy terms (``energy`` empty), a little faster."""
     if hinges is None:
         hinges = no_hinges()
     n = M.shape[0]
@@ -85,13 +88,7 @@ def run_planar_scheme(
     phi, w2 = bas.phi, bas.w2
     nb = w2.shape[0]
     nh = hinges.count if hinges.nonlinear else 0
-    cq = phi.T @ (C @ phi)
-    off = cq - np.diag(np.diag(cq))
-    if np.max(np.abs(off), initial=0.0) > 1e-8 * max(np.max(np.abs(np.diag(cq))), 1e-300):
-        raise InputError("C", "non-classical damping",
-                         "damping that is diagonal in the modes (Rayleigh or modal) for the "
-                         "planar engine")
-    cd = np.ascontiguousarray(np.diag(cq))
+    cd, Co = _reduced_damping(phi, C)
     pat = -(phi.T @ pat_phys)  # (nb, k): modal load per unit of each series
     ser = np.column_stack(series) if series else np.zeros((n_t, 0))
     gz = g + (av if av is not None else np.zeros(n_t))
@@ -122,7 +119,7 @@ def run_planar_scheme(
     bufs = (np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
-            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 5)))
+            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 5 if track_energy else 0)))
     keep_idx = keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     kept_N = np.empty((keep_idx.size, m))
@@ -138,7 +135,7 @@ def run_planar_scheme(
             outs = tuple(b[:k] for b in bufs)
             left = max(int(max_events) - n_ev, 0)
             st, ne, ns, kd_done = mod.run_planar(
-                kd, cd, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
+                kd, cd, Co, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
                 _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
                 stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8])
@@ -176,8 +173,9 @@ def run_planar_scheme(
               for i in range(n_rec)]
     kq, kqd, kqdd, ku, kv, kl, ks, khm, ken = kept
     energy = {nm: ken[:, c].copy() for c, nm in
-              enumerate(("input", "kinetic", "strain", "damping", "friction"))}
-    if nh:
+              enumerate(("input", "kinetic", "strain", "damping", "friction"))
+              } if track_energy else {}
+    if nh and track_energy:
         energy["strain"], energy["hysteresis"] = energy_split(
             energy["strain"], kq, w2, kq @ Q.T + h_th0, khm, h_k, h_th0,
             hinges.initial_moment()[:nh])
@@ -190,3 +188,20 @@ def run_planar_scheme(
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
                       (int(x) for x in stats), strict=True)),
         hinge_moment=khm, hinge_operator=Q, hinge_rotation0=h_th0)
+
+
+def _reduced_damping(phi: np.ndarray, C) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001, N803
+    """(cd, Co): the diagonal of Φᵀ C Φ and its off-diagonal part, or an empty (0, 0) ``Co``
+    when that part is round-off (classical damping: Rayleigh in the modes of K). InputError
+    for a C that is not symmetric (the step's Newton matrix must be)."""
+    cq = phi.T @ (C @ phi)
+    scale = max(np.max(np.abs(cq), initial=0.0), 1e-300)
+    if np.max(np.abs(cq - cq.T), initial=0.0) > 1e-8 * scale:
+        raise InputError("C", "a damping matrix that is not symmetric",
+                         "a symmetric damping matrix C for the planar engine")
+    cq = 0.5 * (cq + cq.T)
+    cd = np.ascontiguousarray(np.diag(cq))
+    off = cq - np.diag(cd)
+    if np.max(np.abs(off), initial=0.0) <= 1e-8 * max(np.max(np.abs(cd), initial=0.0), 1e-300):
+        return cd, np.zeros((0, 0))
+    return cd, np.ascontiguousarray(off)

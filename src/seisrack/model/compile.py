@@ -8,7 +8,8 @@ pivots, :func:`seisrack.fe.stability.is_positive_definite`) → pallets (vertica
 support nodes' uy DOFs, shared equally; horizontal mass kept apart as sliders) → optional P-Δ
 (``[second_order]``: K = K_E + K_G with the axial forces of a linear static gravity solve,
 :mod:`seisrack.fe.geometric`, and the critical load factor) → damping
-(:mod:`seisrack.fe.damping`, the first period by sparse shift-invert Lanczos) → hinges. Nothing
+(:mod:`seisrack.fe.damping`, the first period by sparse shift-invert Lanczos; C = a0·M +
+a1·(K_E + K_G), or a0·M + a1·K_E with ``stiffness_term = "elastic"``) → hinges. Nothing
 here forms a dense (n_dof, n_dof) matrix beyond 500 DOFs.
 """
 
@@ -31,7 +32,7 @@ from seisrack.model.features import check_features
 from seisrack.model.frame_model import FrameModel, read_only
 from seisrack.model.pallet_layout import pallet_layout
 from seisrack.model.rack_mesh import RackMesh, build_rack_mesh
-from seisrack.model.spec import Connections, RackSpec
+from seisrack.model.spec import STIFFNESS_TERMS, Connections, RackSpec
 
 log = logging.getLogger(__name__)
 
@@ -64,18 +65,21 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     r_x, r_y = _influence(nd[:, 0], mesh.n_dof), _influence(nd[:, 1], mesh.n_dof)
     r_z = _influence(nd[:, 2], mesh.n_dof) if mesh.ndm == 3 else None
     lam_cr = None
+    K_E = K
     if spec.second_order.p_delta:
         K, lam_cr = _p_delta(spec, mesh, K, M, r_y)
     horizontal = np.concatenate([p_dofs[:, :, d].ravel() for d in range(len(slots))])
     Mt = M + _diagonal(horizontal, np.tile(share, len(slots)), mesh.n_dof)  # pallets attached
     a0, a1 = _damping(spec, K, Mt, r_x, r_y)
+    K_C = K if spec.damping.stiffness_term == "with_p_delta" else K_E  # the a1 term's K
     plan = _torsion(mesh, Mt, r_x, r_z) if r_z is not None else (None, None)
 
     log.info("compiled %dD rack: %d nodes, %d members, %d bars, %d DOFs, %d pallets",
              mesh.ndm, mesh.nodes.shape[0], mesh.n_el, mesh.trusses.shape[0], mesh.n_dof, n_p)
     return read_only(FrameModel(
-        mesh=mesh, K_sparse=K, M_sparse=M, C_sparse=symmetric_csr(a0 * M + a1 * K),
-        damping_coefficients=(a0, a1), r_x=r_x, r_y=r_y, r_z=r_z, r_theta=plan[1],
+        mesh=mesh, K_sparse=K, M_sparse=M, C_sparse=symmetric_csr(a0 * M + a1 * K_C),
+        damping_coefficients=(a0, a1), damping_stiffness_term=spec.damping.stiffness_term,
+        r_x=r_x, r_y=r_y, r_z=r_z, r_theta=plan[1],
         plan_centre=plan[0], pallet_node=p_node, pallet_dofs=p_dofs, pallet_vdof=p_vdof,
         pallet_mass=p_mass,
         pallet_mu_static=np.array([p.mu_static for p in spec.pallets], dtype=float),
@@ -292,7 +296,12 @@ def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matr
 
 def _damping(spec: RackSpec, K: sp.csr_matrix, Mt: sp.csr_matrix, r_x: FloatArray,
              r_y: FloatArray) -> tuple[float, float]:
+    """(a0, a1) of ``[damping]``; ``period = "first"`` is the first period of K (with K_G under
+    P-Δ), whichever stiffness the a1 term then multiplies (``stiffness_term``)."""
     d = spec.damping
+    if d.stiffness_term not in STIFFNESS_TERMS:
+        raise InputError("damping.stiffness_term", d.stiffness_term,
+                         " or ".join(f'"{x}"' for x in STIFFNESS_TERMS), source=spec.source)
     if d.kind == "stiffness":
         if d.period == "first":
             period = float(modal_from_matrices(K, Mt, r_x, r_y, n_modes=1).periods[0])

@@ -48,7 +48,9 @@ class FrameModel:
             if rigidly attached.
         K, M, C: dense read-only views, built on first access and cached (dropped when
             pickled): small racks and tests only.
-        damping_coefficients: (a0, a1) with C = a0·M + a1·K.
+        damping_coefficients: (a0, a1) with C = a0·M + a1·K_C, K_C the elastic stiffness
+            K_E, or K_E + K_G (with P-Δ) when ``damping_stiffness_term`` is "with_p_delta"
+            (``[damping] stiffness_term``; the same matrix without P-Δ).
         r_x, r_y: (n_dof,) influence vectors of down-aisle and vertical ground motion;
         r_z: (n_dof,) cross-aisle influence vector (None for a 2D rack).
         r_theta: (n_dof,) rigid rotation of the plan about the vertical through
@@ -149,6 +151,7 @@ class FrameModel:
     hinge_rotation_gravity: FloatArray
     title: str = ""
     critical_load_factor: float | None = None
+    damping_stiffness_term: str = "elastic"
     n_rows: int = 1
     frame_z: FloatArray | None = None
 

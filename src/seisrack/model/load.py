@@ -29,6 +29,7 @@ from seisrack.model.spec import (
     DEFAULT_SUBDIVISIONS,
     PINNED,
     RIGID,
+    STIFFNESS_TERMS,
     Connections,
     Damping,
     Geometry,
@@ -403,15 +404,20 @@ def _ratio(t: Table, key: str, value: Any) -> float:
 
 def _damping(t: Table) -> Damping:
     kind = t.string("kind", "none")
+    term = t.string("stiffness_term", "with_p_delta")
+    if term not in STIFFNESS_TERMS:
+        raise t.error("stiffness_term", term,
+                      '"with_p_delta" (a1 times K_E + K_G, the default) or "elastic" (a1 times '
+                      'the elastic stiffness K_E, as OpenSees\' rayleigh with betaKinit)')
     if kind == "none":
-        t.finish(("kind",))
-        return Damping()
+        t.finish(("kind", "stiffness_term"))
+        return Damping(stiffness_term=term)
     if kind == "stiffness":
         ratio = _ratio(t, "ratio", t.raw("ratio"))
         period_raw = t.raw("period", "first")
         period: Any = "first" if period_raw == "first" else _period(t, "period", period_raw)
-        t.finish(("kind", "ratio", "period"))
-        return Damping(kind="stiffness", ratio=ratio, period=period)
+        t.finish(("kind", "ratio", "period", "stiffness_term"))
+        return Damping(kind="stiffness", ratio=ratio, period=period, stiffness_term=term)
     if kind == "rayleigh":
         pairs_raw = t.array("pairs")
         pairs = []
@@ -424,8 +430,8 @@ def _damping(t: Table) -> Damping:
             raise t.error("pairs", pairs_raw, "exactly two [period_s, ratio] pairs")
         if pairs[0][0] == pairs[1][0]:
             raise t.error("pairs", pairs_raw, "two pairs with different periods")
-        t.finish(("kind", "pairs"))
-        return Damping(kind="rayleigh", pairs=tuple(pairs))
+        t.finish(("kind", "pairs", "stiffness_term"))
+        return Damping(kind="rayleigh", pairs=tuple(pairs), stiffness_term=term)
     raise t.error("kind", kind, '"stiffness", "rayleigh" or "none"')
 
 

@@ -29,6 +29,10 @@ RIGID = math.inf
 PINNED = 0.0
 
 DampingKind = Literal["stiffness", "rayleigh", "none"]
+#: the stiffness in the a1 term of the damping: K_E (the elastic stiffness, OpenSees' betaKinit)
+#: or K_E + K_G (with the geometric stiffness of P-Δ); the same without P-Δ
+StiffnessTerm = Literal["elastic", "with_p_delta"]
+STIFFNESS_TERMS = ("elastic", "with_p_delta")
 
 
 @dataclass(frozen=True)
@@ -163,12 +167,21 @@ class Damping:
       ``"first"``, at the first period of the frame with the pallets rigidly attached.
     - ``kind="rayleigh"``: C = a0·M + a1·K through the two ``(period [s], ratio)`` ``pairs``.
     - ``kind="none"``: C = 0.
+
+    ``stiffness_term``: which K the a1 term uses when ``[second_order] p_delta`` adds the
+    geometric stiffness K_G: ``"with_p_delta"`` (default) K_E + K_G, classical in the modes the
+    engine integrates in (exact propagators in 2D, the diagonal planar step in 3D), or
+    ``"elastic"`` K_E, the elastic stiffness of the members and connections (OpenSees'
+    ``rayleigh`` with betaKinit: its initial stiffness has no geometric term; a near-critical
+    rack's sway mode then gets several times the nominal ratio). Without P-Δ both are the
+    same matrix. ``period = "first"`` is the first period of K_E + K_G in both.
     """
 
     kind: DampingKind = "none"
     ratio: float = 0.0
     period: float | Literal["first"] = "first"
     pairs: tuple[tuple[float, float], ...] = ()
+    stiffness_term: StiffnessTerm = "with_p_delta"
 
 
 @dataclass(frozen=True)
