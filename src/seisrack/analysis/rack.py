@@ -45,7 +45,12 @@ from seisrack.dynamics import TimeHistory
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.engine import single_blas_thread
 from seisrack.errors import InputError, SolverError
-from seisrack.model.features import check_engine, require
+from seisrack.model.features import (  # noqa: F401  (non_classical_damping re-exported)
+    check_engine,
+    non_classical_damping,
+    require,
+    takes_newmark,
+)
 from seisrack.model.frame_model import FrameModel
 from seisrack.motion.components import (  # noqa: F401  (DEFAULT_MAX_DT re-exported)
     DEFAULT_MAX_DT,
@@ -140,16 +145,9 @@ def run_rack(
             and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")
     mot = ground_motion(model, motion, vertical)
-    if method == "exact":
-        require("exact modal propagators (method exact)", model.ndm, "method", method)
-        if non_classical_damping(model):
-            raise InputError(
-                "method", method, '"newmark" or "auto" for this rack',
-                hint="With P-Δ, damping a1·K_E ([damping] stiffness_term = \"elastic\") is "
-                     "not classical in the modes of K_E + K_G, which the exact "
-                     "propagators need. Use method \"auto\" (Newmark here), or "
-                     "stiffness_term = \"with_p_delta\" (a1·(K_E + K_G)) for exact propagators")
     check_engine(engine, model, method=method, basis=basis)
+    # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration)
+    newmark = takes_newmark(model, engine, method)
     k = analysis_grid(mot, dt)
     h = mot.dt / k
     mot = mot.padded(int(round(free_vibration / mot.dt)))
@@ -159,17 +157,6 @@ def run_rack(
     else:
         prepared = prepare_run(model, basis=basis, vertical=av is not None, engine=engine)
     ops, hinges = prepared.ops, prepared.hinges
-    line = model.n_dir == 1
-    # Newmark's period-2h acceleration residue is smoothed (smoothed_acceleration); the
-    # engine takes Newmark for sliders in the plane, for a rack on a line exactly when asked
-    # or when the damping has a mass term or is not classical (stiffness_term "elastic" with
-    # P-Δ); the local engine's accelerations are already central differences of its velocities
-    weakening = (np.asarray(model.pallet_friction_rate) > 0.0) & (
-        np.asarray(model.pallet_mu_static) > np.asarray(model.pallet_mu_dynamic))
-    newmark = engine == "default" and (
-        not line or method == "newmark" or hinges is not None or bool(np.any(weakening)) or (
-            method == "auto" and ((model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
-                                  or non_classical_damping(model))))
     tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
     rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False) if (
@@ -275,11 +262,3 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
         fall_rear=np.asarray(lay.fall_rear), falls=falls, impacts=impacts,
         pallet_row=np.asarray(model.pallet_row) if model.n_rows > 1 else None,
     )
-
-
-def non_classical_damping(model: FrameModel) -> bool:
-    """True when the rack's C is not diagonal in the modes of its K: C = a0·M + a1·K_E with
-    P-Δ in K ([damping] ``stiffness_term = "elastic"``). The exact propagators then do not
-    apply and the engine takes Newmark."""
-    return (model.critical_load_factor is not None and model.damping_coefficients[1] != 0.0
-            and model.damping_stiffness_term == "elastic")

@@ -105,6 +105,15 @@ def check_engine(engine: str, model: Any, *, method: str = "auto",
     opt = "--" if cli else ""
     if engine not in ENGINES:
         raise InputError(f"{opt}engine", engine, " or ".join(f'"{e}"' for e in ENGINES))
+    if method == "exact":
+        require("exact modal propagators (method exact)", model.ndm, "method", method)
+        if non_classical_damping(model):
+            raise InputError(
+                "method", method, '"newmark" or "auto" for this rack',
+                hint="With P-Δ, damping a1·K_E ([damping] stiffness_term = \"elastic\") is "
+                     "not classical in the modes of K_E + K_G, which the exact "
+                     "propagators need. Use method \"auto\" (Newmark here), or "
+                     "stiffness_term = \"with_p_delta\" (a1·(K_E + K_G)) for exact propagators")
     if engine == "default":
         return
     if model.nonlinear_hinges:
@@ -121,3 +130,27 @@ def check_engine(engine: str, model: Any, *, method: str = "auto",
     if not (isinstance(basis, str) and basis == "auto"):
         require_engine("a choice of structure basis (basis)", engine, f"{opt}basis",
                        basis if isinstance(basis, str) else type(basis).__name__)
+
+
+def non_classical_damping(model: Any) -> bool:
+    """True when the rack's C is not diagonal in the modes of its K: C = a0·M + a1·K_E with
+    P-Δ in K ([damping] ``stiffness_term = "elastic"``). The exact propagators then do not
+    apply and the engine takes Newmark."""
+    return (model.critical_load_factor is not None and model.damping_coefficients[1] != 0.0
+            and model.damping_stiffness_term == "elastic")
+
+
+def takes_newmark(model: Any, engine: str, method: str) -> bool:
+    """Whether the run of ``model`` integrates by Newmark: the default engine does for sliders
+    in the plane (3D racks), and on a line when asked, with nonlinear hinges or
+    velocity-weakening friction, or when the damping has a mass term (pallets on the rack)
+    or is not classical (:func:`non_classical_damping`); the local engine is a scheme of its
+    own (its accelerations are already central differences of its velocities)."""
+    if engine != "default":
+        return False
+    weakening = (np.asarray(model.pallet_friction_rate) > 0.0) & (
+        np.asarray(model.pallet_mu_static) > np.asarray(model.pallet_mu_dynamic))
+    return (model.n_dir != 1 or method == "newmark" or bool(model.nonlinear_hinges)
+            or bool(np.any(weakening)) or (method == "auto" and (
+                (model.damping_coefficients[0] != 0.0 and model.n_pallets > 0)
+                or non_classical_damping(model))))
