@@ -9,7 +9,8 @@ of about 200 pallets. Each timed run is repeated (``--repeat``, default 3; min a
 reported). No peer: no tool we know of runs rack time histories with planar stick–slip pallets.
 Reports; never asserts on time. Writes ``benchmarks/results/rack3d.md``. Run::
 
-    python benchmarks/rack3d.py [--skip-warehouse] [--ritz-tol TOL] [--repeat N] [--out FILE]
+    python benchmarks/rack3d.py [--skip-warehouse] [--ritz-tol TOL] [--repeat N] [--no-energy]
+                                [--out FILE]
 
 ``--ritz-tol`` replaces the Ritz basis' compression tolerance (default
 ``seisrack.dynamics.planar.PLANAR_RITZ_TOL``): a smaller basis, faster and less accurate.
@@ -77,7 +78,7 @@ def _variant(tmp: Path, label: str) -> Path:
 
 
 def _case(path: str, motion, mu: float | None = None, tol: float | None = None,  # noqa: ANN001
-          repeat: int = 1, label: str | None = None) -> dict:
+          repeat: int = 1, label: str | None = None, energy: bool = True) -> dict:
     import numpy as np
 
     from seisrack.analysis import run_rack
@@ -101,7 +102,7 @@ def _case(path: str, motion, mu: float | None = None, tol: float | None = None, 
     walls, cpus = [], []
     for _ in range(repeat):
         t0, c0 = time.perf_counter(), time.process_time()
-        resp = run_rack(model, motion, save_every=None, basis=basis)
+        resp = run_rack(model, motion, save_every=None, basis=basis, track_energy=energy)
         walls.append(time.perf_counter() - t0)
         cpus.append(time.process_time() - c0)
     h = resp.history
@@ -118,6 +119,8 @@ def main() -> None:
     ap.add_argument("--ritz-tol", type=float, default=None)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", default=str(HERE / "results" / "rack3d.md"))
+    ap.add_argument("--no-energy", action="store_true",
+                    help="run without the energy balance (track_energy=False, as studies do)")
     args = ap.parse_args()
     from seisrack.motion import generate_ec8_record
     from seisrack.motion.components import combine
@@ -130,14 +133,15 @@ def main() -> None:
     start = time.perf_counter()
     rows = []
     with threadpool_limits(1), tempfile.TemporaryDirectory() as tmp:
+        energy = not args.no_energy
         rows.append(_case("examples/paper_rack_3d.toml", motion, tol=args.ritz_tol,
-                          repeat=args.repeat))
+                          repeat=args.repeat, energy=energy))
         if not args.skip_warehouse:
             rows.append(_case("examples/warehouse_rack_3d.toml", motion, tol=args.ritz_tol,
-                              repeat=args.repeat))
+                              repeat=args.repeat, energy=energy))
             for label in VARIANTS:
                 rows.append(_case(str(_variant(Path(tmp), label)), motion, tol=args.ritz_tol,
-                                  repeat=args.repeat, label=label))
+                                  repeat=args.repeat, label=label, energy=energy))
     load1 = os.getloadavg()
     lines = [
         "# 3D racks with planar sliding pallets: run time",
@@ -155,7 +159,8 @@ def main() -> None:
         "2), 20 s at 0.01 s, down-aisle and cross-aisle; analysis dt 5 ms; `save_every=None` "
         "(peaks, falls and impacts over every step). After a 2 s warm-up, "
         f"{args.repeat} timed runs: min (median).",
-        f"- Ritz tolerance: {'default' if args.ritz_tol is None else args.ritz_tol}.",
+        f"- Ritz tolerance: {'default' if args.ritz_tol is None else args.ritz_tol}; energy "
+        f"balance {'not tracked (track_energy=False)' if args.no_energy else 'tracked'}.",
         "- Peer: none (no tool we know of does rack time histories with planar stick–slip "
         "pallets; OpenSees has no planar friction pallet element).",
         "",
