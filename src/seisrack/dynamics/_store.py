@@ -53,16 +53,20 @@ def check_memory(n_steps: int, save_every: int | None, chunk: int, nb: int, m: i
     n_keep, n_t = kept_samples(n_steps, save_every), n_steps + 1
     per_row = 8 * (3 * nb + 4 * m + 5) + m
     need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
-    max_memory = memory_budget(max_memory)
-    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
+    refuse_over_budget(need, max_memory, f"{n_t - 1} steps keeping {n_keep} samples of {nb} "
+                       f"coordinates and {m} sliders",
+                       "Keep fewer samples (save_every=k, or None with on_chunk for peaks only)")
+
+
+def refuse_over_budget(need: float, max_memory: float | None, what: str, hint: str) -> None:
+    """InputError (field ``n_steps``) when a run needing ``need`` bytes, described by
+    ``what``, exceeds :func:`memory_budget`; nothing where the free memory is unknown."""
+    budget = memory_budget(max_memory)
+    if budget is None:  # pragma: no cover - non-POSIX: the free memory is unknown
         return
-    if need > max_memory:
-        raise InputError(
-            "n_steps", f"{n_t - 1} steps keeping {n_keep} samples of {nb} coordinates and "
-            f"{m} sliders ({need / 2**30:.2f} GiB)",
-            f"a run that fits in {max_memory / 2**30:.2f} GiB",
-            hint="Keep fewer samples (save_every=k, or None with on_chunk for peaks only)",
-        )
+    if need > budget:
+        raise InputError("n_steps", f"{what} ({need / 2**30:.2f} GiB)",
+                         f"a run that fits in {budget / 2**30:.2f} GiB", hint=hint)
 
 
 class Buffers:

@@ -14,7 +14,7 @@ import numpy as np
 
 from seisrack.dynamics import _inputs as chk
 from seisrack.dynamics._blas import blas_controller
-from seisrack.dynamics._store import keep_index, memory_budget
+from seisrack.dynamics._store import keep_index, refuse_over_budget
 from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.local.basis import (
     DEFAULT_PATCH,
@@ -285,13 +285,7 @@ def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis)
 
 def _check_memory(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis,
                   max_memory: float | None) -> None:
-    need = memory_estimate(n_keep, chunk, nq, m, basis)
-    max_memory = memory_budget(max_memory)
-    if max_memory is None:  # pragma: no cover - non-POSIX: the free memory is unknown
-        return
-    if need > max_memory:
-        raise InputError(
-            "n_steps", f"{n_keep} kept samples of {nq} coordinates and {m} pallets "
-            f"({need / 2**30:.2f} GiB)", f"a run that fits in {max_memory / 2**30:.2f} GiB",
-            hint="Keep fewer samples (save_every=k, or None with on_chunk), or "
-                 "keep_coordinates=False")
+    refuse_over_budget(memory_estimate(n_keep, chunk, nq, m, basis), max_memory,
+                       f"{n_keep} kept samples of {nq} coordinates and {m} pallets",
+                       "Keep fewer samples (save_every=k, or None with on_chunk), or "
+                       "keep_coordinates=False")
