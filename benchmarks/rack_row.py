@@ -56,10 +56,8 @@ def _motion(seconds: float):  # noqa: ANN202
 
 def run_case(engine: str, path: str, seconds: float) -> dict:
     """One case in this process (called through ``--case``)."""
-    import numpy as np
     from threadpoolctl import threadpool_limits
 
-    from seisrack.analysis.rack import resample
     from seisrack.model import compile_rack, load_rack
 
     model = compile_rack(load_rack(Path(path)))
@@ -80,29 +78,26 @@ def run_case(engine: str, path: str, seconds: float) -> dict:
                        work=r.history.work, energy=r.history.energy_error(),
                        peaks=peaks.tolist(), fell=sorted(f.pallet for f in r.falls))
         else:
-            from seisrack.analysis.engines import run_rack_local
-            from seisrack.dynamics.local.racks import rack_basis
+            from seisrack.analysis import prepare_run, run_rack
 
-            k = 2
-            step = mo.dt / k
-            if model.ndm == 3:
-                ground = np.column_stack([resample(mo.x, k), resample(mo.z, k)])
-            else:
-                ground = resample(mo.x, k)[:, None]
             c0 = time.process_time()
-            b = rack_basis(model)
+            prep = prepare_run(model, engine="local")
+            b = prep.basis
             out["basis_cpu"] = time.process_time() - c0
-            run_rack_local(model, ground[:41], step, basis=b)  # warm numba
+            small = mo.__class__(mo.x[:21], mo.z[:21], None, mo.dt, mo.names)
+            run_rack(model, small, dt=mo.dt / 2, engine="local", prepared=prep,
+                     save_every=None)  # warm numba
             c0, w0 = time.process_time(), time.perf_counter()
-            r = run_rack_local(model, ground, step, basis=b)
+            r = run_rack(model, mo, dt=mo.dt / 2, engine="local", prepared=prep,
+                         save_every=None, throw=False)
             h = r.history
+            peaks = r.pallet_peak_sliding()
             out.update(cpu=time.process_time() - c0, wall=time.perf_counter() - w0,
                        basis=b.size, block=int(b.bmax), slices=b.n_slices,
                        basis_error=b.error.get("static_energy_max"), events=len(h.events),
-                       peak=float(r.peak_sliding[:, 2].max()), falls=len(r.falls),
+                       peak=float(peaks.max()), falls=len(r.falls),
                        work=h.work, energy=h.energy_error(), status=h.status,
-                       peaks=r.peak_sliding[:, 2 if model.ndm == 3 else 0].tolist(),
-                       fell=sorted(f.pallet for f in r.falls))
+                       peaks=peaks.tolist(), fell=sorted(f.pallet for f in r.falls))
     out["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     return out
 

@@ -12,15 +12,13 @@ accelerations carry the period-2h residue of the stiff directions, see
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
-from seisrack.analysis.pallet_contacts import ContactTracker
 from seisrack.analysis.prepare import RIGID_MU, PreparedRun, rack_sliders
 from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics.engine import simulate
-from seisrack.dynamics.local.racks import rack_basis, simulate_local_rack
+from seisrack.dynamics.local.sliders import LocalSliders
 from seisrack.dynamics.results import TimeHistory
 from seisrack.errors import InputError
 from seisrack.model.frame_model import FrameModel
@@ -46,10 +44,10 @@ def simulate_rack(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
         kw = dict(on_chunk=observer, progress=progress if main else None,
                   save_every=save_every if main else None, max_memory=max_memory,
                   throw=throw, backend=backend)
+        sliders = rack_sliders(model, mu, prepared.engine)
         if prepared.engine == "local":
-            run = simulate_rack_local(model, prepared, ag, av, h, mu=mu, **kw)
+            run = simulate_rack_local(model, prepared, sliders, ag, av, h, **kw)
         else:
-            sliders = rack_sliders(model, mu)
             try:
                 run = simulate(
                     model.M_sparse, model.C_sparse, model.K_sparse, sliders, dt=h,
@@ -70,25 +68,21 @@ def simulate_rack(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
     return hist
 
 
-def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
-                        av: np.ndarray | None, h: float, *, mu: float | None = None,
+def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: LocalSliders,
+                        ag: np.ndarray, av: np.ndarray | None, h: float, *,
                         on_chunk: Callable[[Chunk], None] | None = None,
                         progress: Callable[[int], None] | None = None,
                         save_every: int | None = 1, max_memory: float | None = None,
                         throw: bool = True, backend: str = "auto") -> TimeHistory:
     """One run of the local engine on ``model``: ``ag`` (n_t, n_dir) [m/s²] the horizontal
     ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
-    ``mu`` replaces every friction coefficient (the rigid companion)."""
+    ``sliders``: the pallets (:func:`~seisrack.analysis.prepare.rack_sliders`)."""
     from seisrack.dynamics._store import keep_index
-    from seisrack.dynamics.local import LocalSliders
     from seisrack.dynamics.local.engine import simulate_local
 
     b = prepared.basis
     nd = model.n_dir
     line = nd == 1
-    sliders = LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass,
-                           model.pallet_mu_static if mu is None else mu,
-                           model.pallet_mu_dynamic if mu is None else mu)
     n_steps = ag.shape[0] - 1
     keep = keep_index(n_steps, save_every)
     qdd = np.zeros((keep.size, b.size))
@@ -127,49 +121,3 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
         events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,
         method="local", basis=hist.basis, sample_index=hist.sample_index,
         sliding_v=sq(hist.velocity), work=hist.work)
-
-
-@dataclass(frozen=True)
-class RackRun:
-    """What a rack engineer reads from a local-engine run of a compiled rack, over every
-    step: peak_sliding (m, 3) [m] down-aisle, cross-aisle (3D) and magnitude; level_peak
-    (n_level, n_dir) [m] peak mean displacement of each beam level; falls (3D racks with fall
-    limits); history: the engine's result."""
-
-    peak_sliding: np.ndarray
-    level_peak: np.ndarray
-    falls: list
-    history: object
-
-
-def run_rack_local(model, ground: np.ndarray, dt: float, *, basis=None,  # noqa: ANN001
-                   vertical_accel=None, **kw) -> RackRun:  # noqa: ANN001, ANN003
-    """Run a compiled rack (2D or 3D) on the local engine and track its peaks, level
-    displacements and falls over every step (``on_chunk``); keeps two samples only."""
-    is3d = model.ndm == 3
-    if basis is None:
-        basis = rack_basis(model, vertical=vertical_accel is not None)
-    levels = list(model.level_dofs)
-    ops = [np.array([basis.rows(np.asarray(d)).mean(axis=0) for d in lv]) for lv in levels]
-    m = model.n_pallets
-    peak = np.zeros((m, 3))
-    level_peak = np.zeros((len(levels[0]), len(levels)))
-    tracker = ContactTracker(model.layout, m) if is3d and model.layout is not None else None
-
-    def on_chunk(ch) -> None:  # noqa: ANN001
-        u = ch.sliding
-        np.maximum(peak[:, 0], np.abs(u[:, :, 0]).max(axis=0), out=peak[:, 0])
-        if u.shape[2] > 1:
-            np.maximum(peak[:, 1], np.abs(u[:, :, 1]).max(axis=0), out=peak[:, 1])
-        np.maximum(peak[:, 2], np.sqrt((u**2).sum(axis=2)).max(axis=0), out=peak[:, 2])
-        for c, op in enumerate(ops):
-            np.maximum(level_peak[:, c], np.abs(ch.q @ op.T).max(axis=0),
-                       out=level_peak[:, c])
-        if tracker is not None:
-            tracker.update(ch.t, ch.sliding, ch.velocity)
-
-    kw.setdefault("save_every", None)
-    hist = simulate_local_rack(model, ground, dt, basis=basis, vertical_accel=vertical_accel,
-                               on_chunk=on_chunk, keep_coordinates=True, **kw)
-    return RackRun(peak_sliding=peak, level_peak=level_peak,
-                   falls=tracker.falls() if tracker is not None else [], history=hist)

@@ -23,6 +23,7 @@ from seisrack.analysis.operators import RackOperators, rack_operators
 from seisrack.dynamics import PlanarSliders, Sliders
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges
+from seisrack.dynamics.local.sliders import LocalSliders
 from seisrack.dynamics.run_basis import choose_basis
 from seisrack.errors import InputError
 from seisrack.model.frame_model import FrameModel
@@ -52,14 +53,17 @@ class PreparedRun:
         _locked(self)  # shared by every run of the model
 
 
-def rack_sliders(model: FrameModel, mu: float | None = None) -> Sliders | PlanarSliders:
-    """The pallets of ``model`` as the engine's sliders: along a line when the rack has one
+def rack_sliders(model: FrameModel, mu: float | None = None,
+                 engine: str = "default") -> Sliders | PlanarSliders | LocalSliders:
+    """The pallets of ``model`` as ``engine``'s sliders: along a line when the rack has one
     horizontal direction (their supports' down-aisle DOF), in the plane when it has two (their
-    front and rear supports' x and z DOFs). ``mu`` replaces every friction coefficient (the
-    rigid companion run)."""
+    front and rear supports' x and z DOFs); the local engine's take every support and
+    direction. ``mu`` replaces every friction coefficient (the rigid companion run)."""
     mus = model.pallet_mu_static if mu is None else mu
     mud = model.pallet_mu_dynamic if mu is None else mu
     d = model.pallet_dofs
+    if engine == "local":
+        return LocalSliders(np.asarray(d), model.pallet_mass, mus, mud)
     if model.n_dir == 1:
         return Sliders(d[:, 0, 0], model.pallet_mass, mus, mud,
                        model.pallet_friction_rate if mu is None else 0.0)

@@ -182,7 +182,10 @@ def run_rack(
     acc_filt = None if acc_full is None else lowpass(acc_full, h, accel_filter_hz)
     peaks["beam_acceleration_filtered"] = (
         None if acc_filt is None else np.abs(acc_filt).max(axis=0))
-    resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, contacts)
+    force = level_sum(with_direction(hist.friction, hist.planar), model.pallet_level,
+                      ops.n_level)
+    resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, force,
+                     (tuple(contacts.impacts()), tuple(contacts.falls())))
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
@@ -211,7 +214,7 @@ def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
 
 def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.ndarray,
               av: np.ndarray | None, h: float, rigid_peak: np.ndarray | None, ops,  # noqa: ANN001
-              peaks: dict, contacts: ContactTracker) -> RackResponse:
+              peaks: dict, force: np.ndarray, impacts_falls: tuple) -> RackResponse:
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     nd = model.n_dir
     agk = ag[idx]  # (n_t, n_dir)
@@ -227,8 +230,6 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
         acc = smoothed_acceleration(vel, acc_raw - agk[:, None, :], h) + agk[:, None, :]
     else:  # exact propagators leave no period-2h residue; decimated samples are not smoothed
         acc = acc_raw
-    planar = hist.planar
-    force = level_sum(with_direction(hist.friction, planar), model.pallet_level, ops.n_level)
     # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
     # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
     base_shear = hist.q @ ops.shear + ops.a1 * (hist.qd @ ops.shear)
@@ -240,8 +241,7 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
                      for d in range(nd)], axis=-1)
     sq = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
     lay = model.layout
-    impacts = tuple(contacts.impacts())
-    falls = tuple(contacts.falls())
+    impacts, falls = impacts_falls
     return RackResponse(
         t=hist.t, ground_accel=sq(agk), beam_displacement=sq(disp), beam_acceleration=sq(acc),
         beam_acceleration_raw=sq(acc_raw), contact_force=sq(force), base_shear=sq(base_shear),

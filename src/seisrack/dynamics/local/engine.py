@@ -177,7 +177,11 @@ def simulate_local(
             _LOG.warning("local basis: static energy error %.3g of the load patterns", worst)
     N = basis.size
     n_keep = keep_index(n_steps, save_every).size
-    _check_memory(n_keep, chunk, N if keep_coordinates else 0, m, basis, max_memory)
+    need = memory_estimate(n_keep, chunk, N if keep_coordinates else 0, m, basis)
+    refuse_over_budget(need, max_memory,
+                       f"{n_keep} kept samples of {N if keep_coordinates else 0} coordinates "
+                       f"and {m} pallets", "Keep fewer samples (save_every=k, or None with "
+                       "on_chunk), or keep_coordinates=False")
 
     P, ps = support_rows(basis, sliders)
     Vm = basis.matrix()
@@ -281,11 +285,3 @@ def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis)
     work = 8 * (13 * basis.n_slices * basis.bmax**2 + 12 * basis.size + 40 * m
                 + 2 * m * basis.bmax)
     return n_keep * (per_row + 8 * m) + (chunk + 1) * per_row + work
-
-
-def _check_memory(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis,
-                  max_memory: float | None) -> None:
-    refuse_over_budget(memory_estimate(n_keep, chunk, nq, m, basis), max_memory,
-                       f"{n_keep} kept samples of {nq} coordinates and {m} pallets",
-                       "Keep fewer samples (save_every=k, or None with on_chunk), or "
-                       "keep_coordinates=False")

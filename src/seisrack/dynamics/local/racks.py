@@ -50,13 +50,6 @@ def rack_slices(model) -> np.ndarray:  # noqa: ANN001
     return np.unique(raw, return_inverse=True)[1].astype(np.int64)
 
 
-def local_rack_sliders(model) -> LocalSliders:  # noqa: ANN001
-    """The pallets of ``model``: 3D, resting on the front and rear beam nodes, sliding in x
-    and z; 2D, on one DOF, sliding along x."""
-    return LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass, model.pallet_mu_static,
-                        model.pallet_mu_dynamic)
-
-
 def rack_level_patterns(model) -> np.ndarray:  # noqa: ANN001
     """(n, g) a unit load on every DOF of each beam level (3D: per side, x and z; 2D: x);
     weighted by the mass they are the global loads, whose static responses carry the sway of
@@ -95,7 +88,8 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
     from seisrack.dynamics.local.basis import DEFAULT_TOL, local_basis, measure_error
 
     slices, levels = rack_slices(model), rack_level_patterns(model)
-    sl = local_rack_sliders(model)
+    # the pallets' supports and masses (friction plays no part in the basis)
+    sl = LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass, 0.0)
     n = model.K_sparse.shape[0]
     M = model.M_sparse
     extra = sl.attached_mass(n)
@@ -111,21 +105,3 @@ def rack_basis(model, *, tol: float | None = None, patch: int | None = None,  # 
                             n_modes=8 if check == "full" else 0)
         object.__setattr__(b, "error", err)
     return b
-
-
-def simulate_local_rack(model, ground: np.ndarray, dt: float, *,  # noqa: ANN001, ANN201
-                        vertical_accel=None, basis=None, **kw):  # noqa: ANN001, ANN003
-    """:func:`~seisrack.dynamics.local.simulate_local` on a compiled rack: ``ground`` (n_t,
-    n_dir) the down-aisle (and, 3D, cross-aisle) accelerations [m/s²] on the analysis grid;
-    other keywords as ``simulate_local``."""
-    from seisrack.dynamics.local.engine import simulate_local
-
-    infl = np.array(model.influence)
-    if basis is None:
-        basis = rack_basis(model, vertical=vertical_accel is not None)
-    return simulate_local(model.M_sparse, model.C_sparse, model.K_sparse,
-                          local_rack_sliders(model), dt=dt,
-                          ground=np.reshape(ground, (np.shape(ground)[0], -1)),
-                          influence=infl, vertical_accel=vertical_accel,
-                          vertical_influence=None if vertical_accel is None else model.r_y,
-                          g=model.g, basis=basis, **kw)
