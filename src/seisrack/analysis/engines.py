@@ -78,7 +78,7 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: Local
     ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
     ``sliders``: the pallets (:func:`~seisrack.analysis.prepare.rack_sliders`)."""
     from seisrack.dynamics._store import keep_index
-    from seisrack.dynamics.local.engine import simulate_local
+    from seisrack.dynamics.local.scheme import run_local_scheme
 
     b = prepared.basis
     nd = model.n_dir
@@ -106,12 +106,11 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: Local
             on_chunk(Chunk(ch.t, ch.q, v, a, sq(ch.friction), ch.stuck,
                            sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
 
-    hist = simulate_local(
-        model.M_sparse, model.C_sparse, model.K_sparse, sliders, dt=h, ground=ag,
-        influence=np.array(model.influence), vertical_accel=av,
-        vertical_influence=None if av is None else model.r_y, g=model.g, basis=b,
-        check="none", save_every=save_every, keep_coordinates=True, on_chunk=chunk_cb,
-        progress=progress, max_memory=max_memory, throw=throw, backend=backend)
+    hist = run_local_scheme(
+        model.M_sparse, sliders, b, dt=h, ag=ag, r=np.array(model.influence), av=av,
+        rv=None if av is None else model.r_y, g=model.g, save_every=save_every,
+        on_chunk=chunk_cb, progress=progress, max_memory=max_memory, throw=throw,
+        backend=backend)
     n_keep = hist.sample_index.size
     d = np.asarray(model.pallet_dofs)
     return TimeHistory(
