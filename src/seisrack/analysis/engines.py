@@ -5,8 +5,8 @@ the :class:`~seisrack.dynamics.results.TimeHistory` the rest of the path reads (
 writer, report). The local engine's chunks are handed on as the usual
 :class:`~seisrack.dynamics._chunk.Chunk`; its reported accelerations are the central
 differences of the velocities, ``(v[n+1] - v[n-1]) / 2h`` (the trapezoidal rule's own end
-accelerations carry the period-2h residue of the stiff directions, see
-:func:`seisrack.analysis.rack.smoothed_acceleration`).
+accelerations carry the period-2h residue of the stiff directions:
+:func:`seisrack.dynamics.local.result.central_accelerations`).
 """
 
 from __future__ import annotations
@@ -77,44 +77,23 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: Local
     """One run of the local engine on ``model``: ``ag`` (n_t, n_dir) [m/s²] the horizontal
     ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
     ``sliders``: the pallets (:func:`~seisrack.analysis.prepare.rack_sliders`)."""
-    from seisrack.dynamics._store import keep_index
     from seisrack.dynamics.local.scheme import run_local_scheme
 
-    b = prepared.basis
-    nd = model.n_dir
-    line = nd == 1
-    n_steps = ag.shape[0] - 1
-    keep = keep_index(n_steps, save_every)
-    qdd = np.zeros((keep.size, b.size))
-    state: dict = {"v_prev": None}
+    line = model.n_dir == 1
     sq = (lambda a: a[..., 0]) if line else (lambda a: a)  # noqa: E731
 
     def chunk_cb(ch) -> None:  # noqa: ANN001
-        v = ch.v
-        k = v.shape[0]
-        a = np.empty_like(v)
-        if k >= 3:
-            a[1:-1] = (v[2:] - v[:-2]) / (2.0 * h)
-        vp = state["v_prev"]
-        a[0] = (v[1] - vp) / (2.0 * h) if vp is not None else (v[1] - v[0]) / h
-        a[-1] = (v[-1] - v[-2]) / h
-        state["v_prev"] = v[-2].copy()
-        k0 = int(round(ch.t[0] / h))
-        sel = (keep >= k0) & (keep < k0 + k)
-        qdd[sel] = a[keep[sel] - k0]
-        if on_chunk is not None:
-            on_chunk(Chunk(ch.t, ch.q, v, a, sq(ch.friction), ch.stuck,
-                           sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
+        on_chunk(Chunk(ch.t, ch.q, ch.v, ch.a, sq(ch.friction), ch.stuck,
+                       sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
 
     hist = run_local_scheme(
-        model.M_sparse, sliders, b, dt=h, ag=ag, r=np.array(model.influence), av=av,
-        rv=None if av is None else model.r_y, g=model.g, save_every=save_every,
-        on_chunk=chunk_cb, progress=progress, max_memory=max_memory, throw=throw,
-        backend=backend)
-    n_keep = hist.sample_index.size
+        model.M_sparse, sliders, prepared.basis, dt=h, ag=ag, r=np.array(model.influence),
+        av=av, rv=None if av is None else model.r_y, g=model.g, save_every=save_every,
+        on_chunk=None if on_chunk is None else chunk_cb, progress=progress,
+        max_memory=max_memory, throw=throw, backend=backend)
     d = np.asarray(model.pallet_dofs)
     return TimeHistory(
-        t=hist.t, q=hist.q, qd=hist.v, qdd=qdd[:n_keep], phi=b.matrix().tocsr(),
+        t=hist.t, q=hist.q, qd=hist.v, qdd=hist.a, phi=prepared.basis.matrix().tocsr(),
         slider_u=None, slider_v=None, sliding=sq(hist.sliding), friction=sq(hist.friction),
         normal=hist.normal, stuck=hist.stuck, slider_dof=d[:, 0, 0] if line else d[:, :, 0],
         events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,

@@ -15,7 +15,7 @@ from seisrack.dynamics._blas import blas_controller
 from seisrack.dynamics._store import keep_index, refuse_over_budget
 from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.local.basis import LocalBasis
-from seisrack.dynamics.local.result import LocalChunk, LocalHistory
+from seisrack.dynamics.local.result import LocalChunk, LocalHistory, central_accelerations
 from seisrack.dynamics.local.sliders import LocalSliders
 from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event
 from seisrack.errors import InputError, SolverError
@@ -84,6 +84,7 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
 
     P, ps = support_rows(basis, sliders)
     Vm = basis.matrix()
+    described = basis.describe()
     pats_r = [-(Vm.T @ (M @ r[d])) for d in range(nd)]
     series = [ag[:, d] for d in range(nd)]
     if rv is not None:
@@ -115,7 +116,9 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     bufs = (np.empty((chunk + 1, nq)), np.empty((chunk + 1, nq)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m, 2)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m), dtype=np.bool_), np.empty((chunk + 1, 5)))
-    kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
+    acc = np.empty((chunk + 1, nq))  # the central differences of v
+    kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in (*bufs, acc)]
+    v_prev = None
     stats = np.zeros(7, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
     limiter = blas_controller().limit(limits=1, user_api="blas")
@@ -134,12 +137,14 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
                 ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:], stats)
             n_ev += int(ne)
             status = int(st)
+            a = central_accelerations(outs[1], v_prev, dt, acc[:k])
+            v_prev = outs[1][-2].copy() if k >= 2 else None
             if on_chunk is not None:
                 on_chunk(LocalChunk(np.arange(start, start + k) * dt, outs[0], outs[1],
                                     outs[2][:, :, :nd], outs[3][:, :, :nd], outs[4][:, :, :nd],
-                                    outs[5], outs[6]))
+                                    outs[5], outs[6], a))
             sel = (keep_idx >= start) & (keep_idx <= stop)
-            for dst, src in zip(kept, outs, strict=True):
+            for dst, src in zip(kept, (*outs, a), strict=True):
                 dst[sel] = src[keep_idx[sel] - start]
             if status != 0:
                 last = start + int(kd_done)
@@ -162,15 +167,15 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     order = np.argsort(ev_time[:n_rec], kind="stable")
     events = [Event(float(ev_time[i]), int(ev_pallet[i]), EVENT_KINDS[int(ev_kind[i])])
               for i in order]
-    kq, kv, ku, ks, kl, kst, ke = kept
+    kq, kv, ku, ks, kl, kst, ke, ka = kept
     normal = np.clip(np.outer(gz[keep_idx], sliders.mass), 0.0, None)
     energy_d = {"input": ke[:, 0], "kinetic": ke[:, 1], "strain": ke[:, 2],
                 "damping": ke[:, 3], "friction": ke[:, 4], "hysteresis": np.zeros(len(ke))}
     return LocalHistory(
-        t=keep_idx * dt, q=kq, v=kv, sliding=ku[:, :, :nd], velocity=ks[:, :, :nd],
+        t=keep_idx * dt, q=kq, v=kv, a=ka, sliding=ku[:, :, :nd], velocity=ks[:, :, :nd],
         friction=kl[:, :, :nd], normal=normal, stuck=kst, events=events,
         sample_index=keep_idx, energy=energy_d, local_basis=basis, status=status_text,
-        backend=used, basis=basis.describe(),
+        backend=used, basis=described,
         work=dict(zip(("steps", "newton_iterations", "factorisations", "local_solves",
                        "line_search_evaluations", "frozen_contacts", "loose_steps"),
                       (int(x) for x in stats),
@@ -179,7 +184,7 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
 
 def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis) -> int:
     """Bytes the run's kept histories, chunk buffers and kernel work arrays take."""
-    per_row = 8 * (2 * nq + 6 * m + 5) + m
+    per_row = 8 * (3 * nq + 6 * m + 5) + m
     work = 8 * (13 * basis.n_slices * basis.bmax**2 + 12 * basis.size + 40 * m
                 + 2 * m * basis.bmax)
     return n_keep * (per_row + 8 * m) + (chunk + 1) * per_row + work
