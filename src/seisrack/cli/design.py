@@ -109,10 +109,6 @@ def _check_direction(direction: str, have: tuple[str, ...]) -> None:
                          "analysed down-aisle only)")
 
 
-def _g(x: float) -> str:
-    return f"{x:.4g}"
-
-
 def format_design(res: Any, title: str = "") -> str:
     """A readable text summary of a :class:`~seisrack.design.DesignResult`."""
     from seisrack.design.operators import AXIS

@@ -105,14 +105,6 @@ class LocalBasis:
                 "tol": self.tol, "error": dict(self.error)}
 
 
-def slices_by_coordinate(x_dof: np.ndarray, cuts: np.ndarray) -> np.ndarray:
-    """Slice of each DOF from its node's coordinate ``x_dof`` (n,) and the sorted slice
-    starts ``cuts`` (n_s,): slice s holds cuts[s] <= x < cuts[s+1] (1e-9 m tolerance)."""
-    s = np.searchsorted(np.asarray(cuts, float), np.asarray(x_dof, float) + 1e-9,
-                        side="right") - 1
-    return np.clip(s, 0, len(cuts) - 1).astype(np.int64)
-
-
 def check_slices(K: sp.spmatrix, slices: np.ndarray) -> np.ndarray:
     """Slice indices 0..n_s-1, every slice non-empty, elements within adjacent slices."""
     n = K.shape[0]
