@@ -105,7 +105,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     m = mass.shape[0]
     n_t = agx.shape[0]
     nw = max(r, 2 * m, 1)
-    W = np.empty((11, nw))
+    W = np.empty((13, nw))  # scratch: rows 0–9, 11, 12 _trial's, 10 _decide's
     G = np.empty((2 * m, r))
     PF = np.empty((2 * m, r))
     dqa = np.empty(r)  # the last two trials of a location (fractions tha, thb): the next

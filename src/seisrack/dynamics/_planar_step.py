@@ -148,7 +148,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
 
     T rows: q, qd, qdd (r); S rows: w, wd, wdd, lam, s (relative velocity), vn (support
     velocity) (2m). Writes the event values ``e`` (positive when the state is violated) and
-    their thresholds ``tolF``. ``W`` (10, max(r, 2m)), ``G`` and ``PF`` (2m, r) are scratch
+    their thresholds ``tolF``. ``W`` (13, max(r, 2m)) (rows 0–9 and 11–12; row 10 is
+    ``_decide``'s), ``G`` and ``PF`` (2m, r) are scratch
     (``PF``: the sliding pallets' rows of ``P``, so that the products inside Newton's
     iteration skip the stuck pallets); ``stats`` counts trials, Newton iterations and
     factorisations. ``warm``: Newton starts from ``dq_start`` (a prediction from nearby
@@ -159,7 +160,9 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     directions did not converge. Products with ``P`` and ``S`` go through BLAS.
 
     Damping: ``cd`` (r,) its diagonal in the basis, ``Co`` (r, r) the rest (zero diagonal), or
-    (0, 0) when it is diagonal (classical): the products with ``Co`` are skipped then.
+    (0, 0) when it is diagonal (classical): the products with ``Co`` are skipped then (its
+    terms stay exact zeros, set once per call). Without hinges (n_h = 0) their loops are
+    skipped as a whole: the per-iteration cost is then the one of the plain stick–slip step.
 
     Nonlinear hinges (n_h = ``hk.shape[0]``, possibly 0): ``Q`` (n_h, r) their rotations of the
     basis coordinates, ``hth0`` the rotations at q = 0, ``hk`` the elastic stiffness in ``kd``,
@@ -185,9 +188,13 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     kfac = HW[3]  # the hinges' k_t − k in the factor held in A (kept across calls, as A is)
     for i in range(nh):
         thb[i] = hth0[i] + np.dot(Q[i], q0)
-    full = Co.shape[0] > 0
-    od = np.empty(r)  # Co dq, updated with the steps of dq as sd (Co qd0 first)
+    hasco = Co.shape[0] > 0
+    # Co dq, updated with the steps of dq as sd (Co qd0 first), and Co times a Newton step:
+    # exact zeros without Co (then never touched again in this call)
+    od, so = W[11, :r], W[12, :r]
     _damp_off(Co, qd0, od)
+    if not hasco:
+        so[:] = 0.0
     for i in range(r):
         dg[i] = c0 + c2 * cd[i] + kd[i]
         rhs[i] = (pext1[i] + c1 * qd0[i] + qdd0[i] + cd[i] * qd0[i] + od[i]
@@ -231,7 +238,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
         fac[0] = -1.0
         # first iterate: the linear step with the friction of the start of the step
         res[:] = rhs - np.dot(lam, PFs)
-        _minus_qtz(res, Q, hz_c, res)
+        if nh > 0:
+            _minus_qtz(res, Q, hz_c, res)
         _a_lin(A, S, c0, c2, cd, Co, kd)
         stats[2] += 1
         if not _chol(A):
@@ -249,12 +257,12 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     # friction term is a Huber function of y_p): Newton's steps are damped by backtracking on
     # it, which cures the cycling of plain Newton across the disc
     sd = np.empty(r)  # S dq, and pd = PF dq: updated with the steps of dq
-    so = np.empty(r)  # Co times a Newton step
     for _it in range(_NEWTON_MAX if nonlin else 0):
         if _it == 0:
             pd[:] = np.dot(PFs, dq)
             sd[:] = np.dot(Ss, dq)
-            _damp_off(Co, dq, od)
+            if hasco:
+                _damp_off(Co, dq, od)
         # the hinges at this iterate: moments, corrections and tangents (th, dth: scratch)
         thsc = 1e-300
         hpot = 0.0
@@ -283,7 +291,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
             hub0 += _huber(yx, yz, 0.5 * h * mud[p] * N1[p] / mass[p], mass[p], h)
             ymax = max(ymax, abs(zf[jx]) + abs(zf[jx + 1]) + mud[p] * N1[p] * h / mass[p])
         res[:] = rlin - np.dot(lam, PFs)
-        _minus_qtz(res, Q, hz, res)
+        if nh > 0:
+            _minus_qtz(res, Q, hz, res)
         if refac:
             _a_lin(A, S, c0, c2, cd, Co, kd)
             _syrk_lower(A, G, ng)
@@ -295,7 +304,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
                         if da != 0.0:
                             for b in range(a + 1):
                                 A[a, b] += da * Q[i, b]
-            kfac[:] = dth[:nh]
+            if nh > 0:
+                kfac[:] = dth[:nh]
             stats[2] += 1
             if not _chol(A):
                 return 1
@@ -308,7 +318,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
         lin1 = -np.dot(rlin, stp)
         slope = -np.dot(res, stp)
         ss = np.dot(Ss, stp)
-        _damp_off(Co, stp, so)
+        if hasco:
+            _damp_off(Co, stp, so)
         lin2 = 0.0
         for i in range(r):
             lin2 += stp[i] * (dg[i] * stp[i] + c0 * ss[i] + c2 * so[i])
@@ -319,10 +330,6 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
         for i in range(nh):
             hmax = max(hmax, abs(dth[i]))
         hpot *= hmax
-        # and the round-off of lin1: the terms of rlin are far larger than rlin at short steps
-        for i in range(r):
-            hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i])
-                                   + c2 * abs(od[i]))
         # a full step below the stopping tolerance is taken as it is: backtracking would
         # compare changes of the potential at the level of their round-off (at short
         # steps, where 4/h² magnifies it) and could stop on a damped step short of the root
@@ -332,6 +339,12 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
         full = full / max(ymax, 1e-300)
         for i in range(nh):
             full = max(full, abs(dth[i]) / thsc)
+        if full > 1e-12:
+            # and the round-off of lin1 (only the backtracking reads it): the terms of rlin
+            # are far larger than rlin at short steps
+            for i in range(r):
+                hpot += abs(stp[i]) * (abs(rhs[i]) + dg[i] * abs(dq[i]) + c0 * abs(sd[i])
+                                       + c2 * abs(od[i]))
         alpha = 1.0
         for _ls in range(40 if full > 1e-12 else 0):
             hub1 = 0.0
@@ -352,7 +365,7 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
         for i in range(r):
             dq[i] += alpha * stp[i]
             sd[i] += alpha * ss[i]
-        if full:
+        if hasco:
             for i in range(r):
                 od[i] += alpha * so[i]
         for jf in range(nf):
