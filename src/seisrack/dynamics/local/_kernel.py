@@ -32,6 +32,11 @@ STATUS_NOT_PD = 4
 _NEWTON_MAX = 60
 #: Newton iterations after which a stalled step freezes its pallets' slip onsets too
 _NEWTON_FREEZE = 15
+#: Newton iterations of each solve of a step retried with its onsets placed one at a time
+_RETRY_MAX = 30
+#: the static friction coefficient of a pallet held stuck through a retried step (finite: its
+#: square times N² stays finite in the onset test)
+_HELD = 1e100
 #: a step not converged to _NEWTON_TOL in _NEWTON_MAX iterations is accepted when its last
 #: Newton increment is below this fraction of the velocities (counted in the work)
 _NEWTON_LOOSE = 1e-6
@@ -203,6 +208,244 @@ def _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R):
 
 
 @_JIT
+def _newton(k, maxit, freeze, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus_k, mud,
+            Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp, Dn,
+            Ld, X, Ld2, X2, outs, outs_n, ev, t1, t2, stats, rhs, dv, R, Rn, dlt, tmp,
+            vscale):
+    """Newton's method on the step's residual from ``dv`` (with ``outs`` and ``R`` its
+    evaluation), the factor ``Ld``, ``X`` of the Newton matrix given; ``freeze``: a stalled
+    iteration freezes the contacts of pallets with events (``mus_k``). Returns (converged,
+    the last increment's size)."""
+    N = dv.shape[0]
+    m = ps.shape[0]
+    converged = False
+    prev = -1.0
+    refac = False
+    for _it in range(maxit):
+        stats[1] += 1
+        if refac:
+            # a poor contraction: the Newton matrix with the pallets' current ∂J/∂y
+            # (an onset with mu_d < mu_s makes ∂J/∂y negative, bounded by the support's
+            # own stiffness: H stays positive definite, §4.3; if finite differences across
+            # a kink break that, the clipped ∂J/∂y is used)
+            _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                          agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
+                          Gc, gstamp, stamp,
+                          Le, Dp, outs, ev, t1, t2, stats, True)
+            for attempt in range(2):
+                for p in range(m):
+                    for c in range(4):
+                        Dn[p, c] = outs[p, 2 + c]
+                    if attempt == 1:
+                        _psd_row(Dn, p, mass[p])
+                    if nd == 1:
+                        Dn[p, 1] = 0.0
+                        Dn[p, 2] = 0.0
+                        Dn[p, 3] = 0.0
+                _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dn, nd)
+                stats[2] += 1
+                if _btd_factor(Hd, Ho, sizes, Ld2, X2):
+                    Ld[:] = Ld2
+                    X[:] = X2
+                    break
+            refac = False
+        for i in range(N):
+            dlt[i] = -R[i]
+        _btd_solve(Ld, X, sizes, offsets, dlt)
+        g0 = 0.0
+        dmax = 0.0
+        dvmax = 0.0
+        for i in range(N):
+            g0 += R[i] * dlt[i]
+            dmax = max(dmax, abs(dlt[i]))
+            dvmax = max(dvmax, abs(dv[i]))
+        if dmax <= _NEWTON_TOL * max(vscale, dvmax):
+            # the last evaluation (at dv) stands: converged
+            converged = True
+            break
+        # trial point
+        for i in range(N):
+            tmp[i] = dv[i] + dlt[i]
+        _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                      agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
+                      Gc, gstamp, stamp, Le,
+                      Dp, outs_n, ev, t1, t2, stats, False)
+        _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
+        g1 = 0.0
+        for i in range(N):
+            g1 += Rn[i] * dlt[i]
+        alpha = 1.0
+        if g0 < 0.0 and g1 > 0.5 * abs(g0):
+            # line search: root of g(α) = R(dv + α δ)·δ (increasing along δ)
+            lo = 0.0
+            glo = g0
+            hi = 1.0
+            ghi = g1
+            side = 0
+            for _ls in range(40):
+                stats[4] += 1
+                alpha = lo - glo * (hi - lo) / (ghi - glo)
+                for i in range(N):
+                    tmp[i] = dv[i] + alpha * dlt[i]
+                _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0,
+                              Nk1, agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
+                              Gc, gstamp,
+                              stamp, Le, Dp, outs_n, ev, t1, t2, stats, False)
+                _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
+                ga = 0.0
+                for i in range(N):
+                    ga += Rn[i] * dlt[i]
+                if abs(ga) <= 1e-2 * abs(g0):
+                    break
+                if ga < 0.0:
+                    lo = alpha
+                    glo = ga
+                    if side == -1:
+                        ghi *= 0.5
+                    side = -1
+                else:
+                    hi = alpha
+                    ghi = ga
+                    if side == 1:
+                        glo *= 0.5
+                    side = 1
+        for i in range(N):
+            dv[i] = tmp[i]
+            R[i] = Rn[i]
+        for p in range(m):
+            for c in range(_NOUT):
+                outs[p, c] = outs_n[p, c]
+        dvmax = 0.0
+        for i in range(N):
+            dvmax = max(dvmax, abs(dv[i]))
+        if alpha * dmax <= _NEWTON_TOL * max(vscale, dvmax) or dmax == 0.0:
+            converged = True
+            break
+        # the next step estimated from the contraction of the last two full steps (the
+        # state now is the last evaluation's: no further solve is needed)
+        if alpha == 1.0 and 0.0 < prev and dmax < 0.2 * prev \
+                and dmax * (dmax / prev) <= _NEWTON_TOL * max(vscale, dvmax):
+            converged = True
+            break
+        if prev >= 0.0 and alpha * dmax > 0.2 * prev:
+            refac = True
+        prev = alpha * dmax
+        if DEBUG and k == DEBUG_STEP:
+            print("it", _it, "dmax", dmax, "alpha", alpha, "g0", g0, "g1", g1)
+            for p in range(m):
+                print("   p", p, "stuck0", stuck[p], "J", outs[p, 0], outs[p, 1], "D",
+                      outs[p, 2], outs[p, 3], outs[p, 4], outs[p, 5], "end", outs[p, 6],
+                      "nev", outs[p, 17], "mus_k", mus_k[p])
+        if freeze and _it >= 6 and _it % 3 == 0 and _it < maxit - 1:
+            # stalled: a pallet whose impulse jumps with y (a grazing slip onset, where
+            # the holding force touches mu_s N inside the step) has no root; it keeps its
+            # start state's contact for this step (theory §4.3)
+            for i in range(N):
+                tmp[i] = dv[i] + 1e-6 * dlt[i]
+            _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                          agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
+                          Gc, gstamp, stamp,
+                          Le, Dp, outs_n, ev, t1, t2, stats, False)
+            for p in range(m):
+                dj = abs(outs_n[p, 0] - outs[p, 0]) + abs(outs_n[p, 1] - outs[p, 1])
+                if dj > 1e-4 * (abs(outs[p, 0]) + abs(outs[p, 1]) + mass[p] * h):
+                    mus_k[p] = 1e300
+                    stats[5] += 1
+                elif _it >= _NEWTON_FREEZE and outs[p, 17] > 0.0 and mus_k[p] < 1e300:
+                    # still stalled: a pallet with an event inside the step keeps (or,
+                    # after a stop, takes) the contact for the rest of the step: a slip
+                    # onset whose impulse falls with y as fast as the support's
+                    # compliance allows (mu_d < mu_s: H is singular along it, the onset
+                    # time undetermined; 3D paper rack under El Centro, four pallets at
+                    # t = 2.055 s), or a stop whose restart toggles between iterations
+                    mus_k[p] = 1e300
+                    stats[5] += 1
+            _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                          agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
+                          Gc, gstamp, stamp,
+                          Le, Dp, outs, ev, t1, t2, stats, False)
+            _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+    return converged, prev
+
+
+@_JIT
+def _onsets_in_turn(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, mus_k, mud,
+                    Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le,
+                    Dp, Dn, Ld, X, Ld2, X2, outs, outs_n, ev, t1, t2, stats, rhs, dv, R, Rn,
+                    dlt, tmp, vscale, dvp, dvs, tried):
+    """A step whose Newton iteration failed, retried from its start contacts with its slip
+    onsets placed one at a time (theory §4.5): every pallet stuck at the start is held and the
+    step solved; then, while a held pallet's holding force reaches mu_s N inside the step, the
+    one whose onset comes first is released and the step solved again from the last solution.
+    A release whose Newton iteration does not converge in _RETRY_MAX iterations is undone and
+    that pallet keeps its contact for the step (counted in ``stats[5]``, frozen contacts).
+    Bounded: one solve per pallet at most. Returns (converged, the last increment's size)."""
+    N = dv.shape[0]
+    m = ps.shape[0]
+    stats[7] += 1
+    for p in range(m):
+        mus_k[p] = _HELD if stuck[p] else mus[p]
+        tried[p] = False
+    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
+    stats[2] += 1
+    if not _btd_factor(Hd, Ho, sizes, Ld, X):
+        return False, -1.0
+    for i in range(N):
+        dv[i] = dvp[i]
+    _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
+                  agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp,
+                  outs, ev, t1, t2, stats, False)
+    _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+    conv, prev = _newton(k, _RETRY_MAX, False, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h,
+                         mass, mus_k, mud, Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta, nprev,
+                         Gc, gstamp, stamp, Le, Dp, Dn, Ld, X, Ld2, X2, outs, outs_n, ev, t1,
+                         t2, stats, rhs, dv, R, Rn, dlt, tmp, vscale)
+    if not conv:
+        return False, prev
+    last = prev
+    for _r in range(m):
+        # the held pallets with a slip onset at this solution (their own friction law)
+        _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, agp[k],
+                      agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le,
+                      Dp, outs_n, ev, t1, t2, stats, False)
+        q = -1
+        tq = 1e300
+        for p in range(m):
+            if mus_k[p] >= _HELD and not tried[p] and outs_n[p, 17] > 0.0 \
+                    and ev[p, 0, 0] < tq:
+                q = p
+                tq = ev[p, 0, 0]
+        if q < 0:
+            break
+        tried[q] = True
+        stats[8] += 1
+        for i in range(N):
+            dvs[i] = dv[i]
+        mus_k[q] = mus[q]
+        _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
+                      agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le,
+                      Dp, outs, ev, t1, t2, stats, False)
+        _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+        conv, prev = _newton(k, _RETRY_MAX, False, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd,
+                             h, mass, mus_k, mud, Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta,
+                             nprev, Gc, gstamp, stamp, Le, Dp, Dn, Ld, X, Ld2, X2, outs,
+                             outs_n, ev, t1, t2, stats, rhs, dv, R, Rn, dlt, tmp, vscale)
+        if conv:
+            last = prev
+        else:
+            mus_k[q] = _HELD
+            stats[5] += 1
+            for i in range(N):
+                dv[i] = dvs[i]
+    # the step's solution with its final contacts (its events in ``ev``)
+    _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
+                  agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp,
+                  outs, ev, t1, t2, stats, False)
+    _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+    return True, last
+
+
+@_JIT
 def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud, dt, pat,
               ser, agp, gz, resume, q, v, dvp, stuck, sv, dirn, uu, lam, beta, jerk, nprev,
               Dp, rows, energy, t_offset, max_events, out_q, out_v, out_u, out_s, out_lam,
@@ -239,6 +482,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
     Rb = np.zeros_like(Md)
     Yb = np.zeros_like(Md)
     Dn = np.zeros((m, 4))
+    dvs = np.empty(q.shape[0])
+    tried = np.zeros(m, dtype=np.bool_)
     jlast = jerk[:, 2:]  # the last difference of beta (stored beside the jerk)
     rhs = np.empty(N)
     R = np.empty(N)
@@ -334,153 +579,22 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
         vscale = 1e-300
         for i in range(N):
             vscale = max(vscale, abs(v[i]) + abs(dvp[i]))
-        converged = False
-        prev = -1.0
-        refac = False
-        for _it in range(_NEWTON_MAX):
-            stats[1] += 1
-            if refac:
-                # a poor contraction: the Newton matrix with the pallets' current ∂J/∂y
-                # (an onset with mu_d < mu_s makes ∂J/∂y negative, bounded by the support's
-                # own stiffness: H stays positive definite, §4.3; if finite differences across
-                # a kink break that, the clipped ∂J/∂y is used)
-                _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
-                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                              Gc, gstamp, stamp,
-                              Le, Dp, outs, ev, t1, t2, stats, True)
-                for attempt in range(2):
-                    for p in range(m):
-                        for c in range(4):
-                            Dn[p, c] = outs[p, 2 + c]
-                        if attempt == 1:
-                            _psd_row(Dn, p, mass[p])
-                        if nd == 1:
-                            Dn[p, 1] = 0.0
-                            Dn[p, 2] = 0.0
-                            Dn[p, 3] = 0.0
-                    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dn, nd)
-                    stats[2] += 1
-                    if _btd_factor(Hd, Ho, sizes, Ld2, X2):
-                        Ld[:] = Ld2
-                        X[:] = X2
-                        break
-                refac = False
-            for i in range(N):
-                dlt[i] = -R[i]
-            _btd_solve(Ld, X, sizes, offsets, dlt)
-            g0 = 0.0
-            dmax = 0.0
-            dvmax = 0.0
-            for i in range(N):
-                g0 += R[i] * dlt[i]
-                dmax = max(dmax, abs(dlt[i]))
-                dvmax = max(dvmax, abs(dv[i]))
-            if dmax <= _NEWTON_TOL * max(vscale, dvmax):
-                # the last evaluation (at dv) stands: converged
-                converged = True
-                break
-            # trial point
-            for i in range(N):
-                tmp[i] = dv[i] + dlt[i]
-            _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
-                          agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                          Gc, gstamp, stamp, Le,
-                          Dp, outs_n, ev, t1, t2, stats, False)
-            _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
-            g1 = 0.0
-            for i in range(N):
-                g1 += Rn[i] * dlt[i]
-            alpha = 1.0
-            if g0 < 0.0 and g1 > 0.5 * abs(g0):
-                # line search: root of g(α) = R(dv + α δ)·δ (increasing along δ)
-                lo = 0.0
-                glo = g0
-                hi = 1.0
-                ghi = g1
-                side = 0
-                for _ls in range(40):
-                    stats[4] += 1
-                    alpha = lo - glo * (hi - lo) / (ghi - glo)
-                    for i in range(N):
-                        tmp[i] = dv[i] + alpha * dlt[i]
-                    _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0,
-                                  Nk1, agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                                  Gc, gstamp,
-                                  stamp, Le, Dp, outs_n, ev, t1, t2, stats, False)
-                    _residual(Ad, Ao, sizes, offsets, tmp, rhs, P, ps, nd, outs_n, Rn)
-                    ga = 0.0
-                    for i in range(N):
-                        ga += Rn[i] * dlt[i]
-                    if abs(ga) <= 1e-2 * abs(g0):
-                        break
-                    if ga < 0.0:
-                        lo = alpha
-                        glo = ga
-                        if side == -1:
-                            ghi *= 0.5
-                        side = -1
-                    else:
-                        hi = alpha
-                        ghi = ga
-                        if side == 1:
-                            glo *= 0.5
-                        side = 1
-            for i in range(N):
-                dv[i] = tmp[i]
-                R[i] = Rn[i]
-            for p in range(m):
-                for c in range(_NOUT):
-                    outs[p, c] = outs_n[p, c]
-            dvmax = 0.0
-            for i in range(N):
-                dvmax = max(dvmax, abs(dv[i]))
-            if alpha * dmax <= _NEWTON_TOL * max(vscale, dvmax) or dmax == 0.0:
-                converged = True
-                break
-            # the next step estimated from the contraction of the last two full steps (the
-            # state now is the last evaluation's: no further solve is needed)
-            if alpha == 1.0 and 0.0 < prev and dmax < 0.2 * prev \
-                    and dmax * (dmax / prev) <= _NEWTON_TOL * max(vscale, dvmax):
-                converged = True
-                break
-            if prev >= 0.0 and alpha * dmax > 0.2 * prev:
-                refac = True
-            prev = alpha * dmax
-            if DEBUG and k == DEBUG_STEP:
-                print("it", _it, "dmax", dmax, "alpha", alpha, "g0", g0, "g1", g1)
-                for p in range(m):
-                    print("   p", p, "stuck0", stuck[p], "J", outs[p, 0], outs[p, 1], "D",
-                          outs[p, 2], outs[p, 3], outs[p, 4], outs[p, 5], "end", outs[p, 6],
-                          "nev", outs[p, 17], "mus_k", mus_k[p])
-            if _it >= 6 and _it % 3 == 0 and _it < _NEWTON_MAX - 1:
-                # stalled: a pallet whose impulse jumps with y (a grazing slip onset, where
-                # the holding force touches mu_s N inside the step) has no root; it keeps its
-                # start state's contact for this step (theory §4.3)
-                for i in range(N):
-                    tmp[i] = dv[i] + 1e-6 * dlt[i]
-                _eval_pallets(tmp, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
-                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                              Gc, gstamp, stamp,
-                              Le, Dp, outs_n, ev, t1, t2, stats, False)
-                for p in range(m):
-                    dj = abs(outs_n[p, 0] - outs[p, 0]) + abs(outs_n[p, 1] - outs[p, 1])
-                    if dj > 1e-4 * (abs(outs[p, 0]) + abs(outs[p, 1]) + mass[p] * h):
-                        mus_k[p] = 1e300
-                        stats[5] += 1
-                    elif _it >= _NEWTON_FREEZE and outs[p, 17] > 0.0 and mus_k[p] < 1e300:
-                        # still stalled: a pallet with an event inside the step keeps (or,
-                        # after a stop, takes) the contact for the rest of the step: a slip
-                        # onset whose impulse falls with y as fast as the support's
-                        # compliance allows (mu_d < mu_s: H is singular along it, the onset
-                        # time undetermined; 3D paper rack under El Centro, four pallets at
-                        # t = 2.055 s), or a stop whose restart toggles between iterations
-                        mus_k[p] = 1e300
-                        stats[5] += 1
-                _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
-                              agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev,
-                              Gc, gstamp, stamp,
-                              Le, Dp, outs, ev, t1, t2, stats, False)
-                _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+        frozen0 = stats[5]
+        converged, prev = _newton(k, _NEWTON_MAX, True, Ad, Ao, Hd, Ho, sizes, offsets, P, ps,
+                                  nd, h, mass, mus_k, mud, Nk0, Nk1, agp, stuck, sv, dirn,
+                                  jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp, Dn, Ld, X, Ld2,
+                                  X2, outs, outs_n, ev, t1, t2, stats, rhs, dv, R, Rn, dlt, tmp,
+                                  vscale)
+        if not converged:
+            # a cluster of slip onsets that does not contract: the step retried from its start
+            # contacts with the onsets placed one at a time (the freezes of the failed
+            # iteration are discarded with it)
+            stats[5] = frozen0
+            converged, prev = _onsets_in_turn(
+                k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, mus_k, mud, Nk0,
+                Nk1, agp, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp, Dn,
+                Ld, X, Ld2, X2, outs, outs_n, ev, t1, t2, stats, rhs, dv, R, Rn, dlt, tmp,
+                vscale, dvp, dvs, tried)
         if not converged:
             # still moving after _NEWTON_MAX iterations (a linear contraction near a pallet's
             # stop or frozen onset): accepted when the last increment is below

@@ -119,7 +119,7 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     acc = np.empty((chunk + 1, nq))  # the central differences of v
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in (*bufs, acc)]
     v_prev = None
-    stats = np.zeros(7, dtype=np.int64)
+    stats = np.zeros(9, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
     limiter = blas_controller().limit(limits=1, user_api="blas")
     try:
@@ -177,7 +177,8 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
         sample_index=keep_idx, energy=energy_d, local_basis=basis, status=status_text,
         backend=used, basis=described,
         work=dict(zip(("steps", "newton_iterations", "factorisations", "local_solves",
-                       "line_search_evaluations", "frozen_contacts", "loose_steps"),
+                       "line_search_evaluations", "frozen_contacts", "loose_steps",
+                       "retried_steps", "placed_onsets"),
                       (int(x) for x in stats),
                       strict=True)))
 
