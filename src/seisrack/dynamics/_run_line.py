@@ -24,9 +24,9 @@ from seisrack.dynamics._store import Kept as _Kept
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split
 from seisrack.dynamics.kernels import get_kernel, writable
-from seisrack.dynamics.results import EVENT_KINDS, Event, TimeHistory
+from seisrack.dynamics.results import TimeHistory, recorded_events, run_status
 from seisrack.dynamics.sliders import Sliders
-from seisrack.errors import InputError, SolverError
+from seisrack.errors import InputError
 
 _LOG = logging.getLogger(__name__)
 
@@ -157,17 +157,8 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
                 progress(stop - start)
             start = stop
 
-    status_text = _STATUS.get(int(status), f"status {status}")
-    if status != 0:
-        msg = f"stick-slip integration stopped: {status_text}"
-        if throw:
-            raise SolverError(msg)
-        _LOG.warning(msg)
-    n_keep_ev = min(int(n_ev), max_events)
-    events = [
-        Event(float(ev_time[k]), int(ev_slider[k]), EVENT_KINDS[int(ev_kind[k])])
-        for k in range(n_keep_ev)
-    ]
+    status_text = run_status(status, _STATUS, "stick-slip integration", throw, _LOG)
+    events = recorded_events(ev_time, ev_slider, ev_kind, min(int(n_ev), max_events))
     kq, kqd, kqdd, kw, kwd, klam, kst, ken, khm, kN, kidx = keep.result()
     energy = {}
     if track_energy:

@@ -23,9 +23,9 @@ from seisrack.dynamics._store import keep_index
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import scheme_kernel, writable
-from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event, TimeHistory
+from seisrack.dynamics.results import STEP_STATUS, TimeHistory, recorded_events, run_status
 from seisrack.dynamics.sliders import PlanarSliders
-from seisrack.errors import InputError, SolverError
+from seisrack.errors import InputError
 
 _LOG = logging.getLogger(__name__)
 
@@ -162,15 +162,8 @@ def run_planar_scheme(
             if progress is not None:
                 progress(stop - start)
             start = stop
-    status_text = _STATUS.get(status, f"status {status}")
-    if status != 0:
-        msg = f"planar stick–slip engine stopped: {status_text}"
-        if throw:
-            raise SolverError(msg)
-        _LOG.warning(msg)
-    n_rec = min(n_ev, max_events)
-    events = [Event(float(ev_time[i]), int(ev_pallet[i]), EVENT_KINDS[int(ev_kind[i])])
-              for i in range(n_rec)]
+    status_text = run_status(status, _STATUS, "planar stick–slip engine", throw, _LOG)
+    events = recorded_events(ev_time, ev_pallet, ev_kind, min(n_ev, max_events))
     kq, kqd, kqdd, ku, kv, kl, ks, khm, ken = kept
     energy = {nm: ken[:, c].copy() for c, nm in
               enumerate(("input", "kinetic", "strain", "damping", "friction"))

@@ -7,6 +7,8 @@ from functools import cached_property
 
 import numpy as np
 
+from seisrack.errors import SolverError
+
 EVENT_KINDS = ("slip", "stick", "reverse")
 #: status codes that the planar and local kernels share (each adds its own)
 STEP_STATUS = {
@@ -24,6 +26,27 @@ class Event:
     time_s: float
     slider: int
     kind: str
+
+
+def run_status(status: int, names: dict[int, str], what: str, throw: bool, log) -> str:  # noqa: ANN001
+    """The text of a kernel's final ``status`` (``names``); a stopped run raises
+    :class:`~seisrack.errors.SolverError` ("``what`` stopped: ...") when ``throw``, else the
+    message goes to ``log`` as a warning and the run returns what it has."""
+    text = names.get(int(status), f"status {status}")
+    if status != 0:
+        msg = f"{what} stopped: {text}"
+        if throw:
+            raise SolverError(msg)
+        log.warning(msg)
+    return text
+
+
+def recorded_events(time: np.ndarray, slider: np.ndarray, kind: np.ndarray, n: int,
+                    *, by_time: bool = False) -> list[Event]:
+    """The first ``n`` events of a kernel's buffers (``by_time``: sorted by time, stably, for a
+    kernel that records them out of order)."""
+    idx = np.argsort(time[:n], kind="stable") if by_time else range(n)
+    return [Event(float(time[i]), int(slider[i]), EVENT_KINDS[int(kind[i])]) for i in idx]
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,8 @@ from seisrack.dynamics.kernels import scheme_kernel, writable
 from seisrack.dynamics.local.basis import LocalBasis
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory, central_accelerations
 from seisrack.dynamics.local.sliders import LocalSliders
-from seisrack.dynamics.results import EVENT_KINDS, STEP_STATUS, Event
-from seisrack.errors import InputError, SolverError
+from seisrack.dynamics.results import STEP_STATUS, recorded_events, run_status
+from seisrack.errors import InputError
 
 _LOG = logging.getLogger(__name__)
 
@@ -157,16 +157,8 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
             start = stop
     finally:
         limiter.restore_original_limits()
-    status_text = _STATUS.get(status, f"status {status}")
-    if status != 0:
-        msg = f"local stick–slip engine stopped: {status_text}"
-        if throw:
-            raise SolverError(msg)
-        _LOG.warning(msg)
-    n_rec = min(n_ev, max_events)
-    order = np.argsort(ev_time[:n_rec], kind="stable")
-    events = [Event(float(ev_time[i]), int(ev_pallet[i]), EVENT_KINDS[int(ev_kind[i])])
-              for i in order]
+    status_text = run_status(status, _STATUS, "local stick–slip engine", throw, _LOG)
+    events = recorded_events(ev_time, ev_pallet, ev_kind, min(n_ev, max_events), by_time=True)
     kq, kv, ku, ks, kl, kst, ke, ka = kept
     normal = np.clip(np.outer(gz[keep_idx], sliders.mass), 0.0, None)
     energy_d = {"input": ke[:, 0], "kinetic": ke[:, 1], "strain": ke[:, 2],
