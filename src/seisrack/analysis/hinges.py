@@ -64,11 +64,13 @@ _LAW_NAMES = {0: "elastic", 1: "elastic-plastic", 2: "bilinear", 3: "pinching"}
 
 
 def rack_hinges(model: FrameModel) -> Hinges | None:
-    """The model's connection springs as engine hinges, or None when all are elastic."""
-    if not model.nonlinear_hinges:
+    """The model's connection springs as engine hinges, with the P-Δ of the current axial
+    forces when the rack asks for it; None when every connection is elastic and the axial
+    forces are the gravity ones."""
+    if not model.nonlinear_hinges and model.axial_p_delta is None:
         return None
     return Hinges(model.hinge_dofs, model.hinge_k, model.hinge_law, model.hinge_par,
-                  model.hinge_rotation_gravity)
+                  model.hinge_rotation_gravity, axial=model.axial_p_delta)
 
 
 def hinge_labels(model: FrameModel) -> tuple[str, ...]:

@@ -156,7 +156,11 @@ def run_rack(
         checked_prepared(prepared, model, engine)
     else:
         prepared = prepare_run(model, basis=basis, vertical=av is not None, engine=engine)
-    ops, hinges = prepared.ops, prepared.hinges
+    ops = prepared.ops
+    # the connections' response is reported when some law is nonlinear (the hinges may carry
+    # only the P-Δ of the current axial forces)
+    hinges = prepared.hinges if prepared.hinges is not None and prepared.hinges.nonlinear \
+        else None
     tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
                           design=True)
     rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False) if (

@@ -148,6 +148,10 @@ def run_inputs(M, C, K, sliders, *, dt, n_steps, ground_accel, influence, force,
     if not isinstance(hinges, Hinges):
         raise InputError("hinges", type(hinges).__name__, "a seisrack.dynamics.hinges.Hinges")
     hinges.check(n)
+    if hinges.axial is not None and not planar:
+        raise InputError("hinges.axial", "the P-Δ of the current axial forces",
+                         "None for sliders on a line: it is built in the planar scheme only "
+                         "(sliders in the plane, 3D racks)")
     if planar:
         given = {"force": force, "u0": u0, "v0": v0,
                  "method": method if method == "exact" else None}

@@ -41,6 +41,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _propose3,
         _substep_end,
     )
+    from seisrack.dynamics._planar_axial import _axial_force, _trial_ax
     from seisrack.dynamics._planar_events import (
         _classify,
         _decide,
@@ -53,7 +54,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _track_direction,
     )
     from seisrack.dynamics._planar_hinges import _hinge_commit_at, _hinge_committed, _minus_qtz
-    from seisrack.dynamics._planar_step import _sample_row, _trial
+    from seisrack.dynamics._planar_step import _sample_row
 
 #: status of a Newton iteration of the planar step that did not converge
 STATUS_PLANAR_NEWTON = 4
@@ -73,7 +74,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                stuck, dirn, S, A, fac, t_offset, max_events, max_substeps,
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
                ev_time, ev_pallet, ev_kind, stats,
-               Q, hth0, hk, hlaw, hpar, hst, HW, e_state, out_hm, out_energy):
+               Q, hth0, hk, hlaw, hpar, hst, HW, e_state, out_hm, out_energy,
+               AA, AG, Ao, As, Ac):
     """Integrate ``agx.shape[0] - 1`` steps. Returns (status, n_events, n_substeps, the last
     output row written).
 
@@ -97,9 +99,14 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     committed states (read and written back, as the pallets' state), ``HW`` (4, n_h) scratch
     that goes with ``A``; ``out_hm`` (n_t, n_h) their moments. Energy (cumulative from the
     start of the run, resumed from ``e_state``: input, damping, friction, the hinges'
-    correction work ∫ z dθ): ``out_energy`` (n_t, 5) columns input, kinetic, strain (with the
-    hinges' correction work), damping, friction; ``out_energy`` with no columns (n_t, 0): the
-    energy terms are not computed (nobody reads them: a study's runs).
+    correction work ∫ z dθ, the work of the P-Δ of the axial forces' change ∫ f · dq):
+    ``out_energy`` (n_t, 6) columns input, kinetic, strain (with both works), damping,
+    friction, the P-Δ work; ``out_energy`` with no columns (n_t, 0): the energy terms are not
+    computed (nobody reads them: a study's runs).
+
+    The P-Δ of the current axial forces (``_planar_axial.py``): ``AA`` (n_m, r), ``AG``
+    (n_g, r), ``Ao``, ``As``, ``Ac`` (n_g,) the operators of :mod:`seisrack.dynamics.axial` in
+    the basis; no rows (n_g = 0): none, and the trials are the plain ones.
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -151,9 +158,16 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     dqe = np.empty(r)
     ena = np.empty(2)
     E_in, E_damp, E_fric, E_z = e_state[0], e_state[1], e_state[2], e_state[3]
+    E_ax = e_state[4]
     track = out_energy.shape[1] > 0
+    AXW = np.empty((4, r))  # scratch of _trial_ax
+    dn = np.empty(AA.shape[0])
+    gw = np.empty(AG.shape[0])
+    fa = np.empty(r)  # the axial P-Δ force at the committed state, and at a trial's end
+    fb = np.empty(r)
+    axial = AG.shape[0] > 0
     if not resume:
-        E_in, E_damp, E_fric, E_z = 0.0, 0.0, 0.0, 0.0
+        E_in, E_damp, E_fric, E_z, E_ax = 0.0, 0.0, 0.0, 0.0, 0.0
         # pallets start stuck, moving with their supports
         stuck[:] = False
         S[:, :] = 0.0
@@ -171,6 +185,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
         ag[0] = agx[0]
         ag[1] = agz[0]
         _minus_qtz(pext[0], Q, hz, pz)
+        if axial:
+            _axial_force(AA, AG, Ao, As, Ac, T0[0], dn, gw, fa)
+            for i in range(r):
+                pz[i] -= fa[i]
         _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, N[0], stuck, dirn,
                 cand, forced, A, pe, forced)
         for p in range(m):
@@ -181,8 +199,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
         _fill_relative(P, T0, S0)
     _output(0, P, T0, S0, stuck, out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck)
     out_hm[0, :] = hM
+    if axial:
+        _axial_force(AA, AG, Ao, As, Ac, T0[0], dn, gw, fa)
     if track:
-        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, out_energy)
     k_done = 0
     n_tr = np.zeros(m, dtype=np.int64)
     frozen = np.zeros(m, dtype=np.bool_)
@@ -200,9 +220,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
             ag[1] = agz[k + 1]
             for i in range(r):
                 dqg[i] = hrem * T0[1, i] + 0.5 * hrem * hrem * T0[2, i]
-            ok = _trial(hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag,
-                        pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF, stats,
-                        dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt, hzt, HW)
+            ok = _trial_ax(hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn,
+                           ag, pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF,
+                           stats, dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt,
+                           hzt, HW, AA, AG, Ao, As, Ac, AXW, dn, gw)
             _mask_frozen(frozen, e_hi)
             if ok != 0:
                 status = STATUS_PLANAR_NEWTON + ok - 1
@@ -252,10 +273,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                         for i in range(r):
                             dqg[i] = hs * T0[1, i] + 0.25 * hs * hs * (
                                 2.0 * T0[2, i] + th * (qdd_full[i] - T0[2, i]))
-                    ok = _trial(th * hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck,
-                                dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G, PF, stats,
-                                dqg, warm, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt,
-                                hzt, HW)
+                    ok = _trial_ax(th * hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0,
+                                   stuck, dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G,
+                                   PF, stats, dqg, warm, fac, Q, hth0, hk, hlaw, hpar, hst,
+                                   hst_t, hz, hMt, hzt, HW, AA, AG, Ao, As, Ac, AXW, dn, gw)
                     dqb[:] = dqa
                     thb = tha
                     tha = th
@@ -288,6 +309,11 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                     for i in range(r):
                         pea[i] = 0.5 * (T0[1, i] + T1[1, i])
                     E_damp += np.dot(dqe, np.dot(Co, pea))
+                if axial:  # the P-Δ force's work, by the trapezoid as every other force's
+                    _axial_force(AA, AG, Ao, As, Ac, T1[0], dn, gw, fb)
+                    for i in range(r):
+                        E_ax += 0.5 * (fa[i] + fb[i]) * dqe[i]
+                    fa[:] = fb
                 vrel = np.dot(P, dqe)
                 for p in range(m):
                     for c in range(2):
@@ -312,6 +338,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
                 _minus_qtz(pe, Q, hz, pz)
+                if axial:
+                    _axial_force(AA, AG, Ao, As, Ac, T0[0], dn, gw, fb)
+                    for i in range(r):
+                        pz[i] -= fb[i]
                 _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, Ne, stuck, dirn,
                         cand, forced, A, W[10, :r], frozen)
                 fac[0] = -1.0
@@ -340,7 +370,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                 out_stuck)
         out_hm[k + 1, :] = hM
         if track:
-            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy)
+            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax,
+                        out_energy)
         k_done = k + 1
         if not np.isfinite(T0[0, 0]):
             status = STATUS_NONFINITE
@@ -353,17 +384,19 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     e_state[1] = E_damp
     e_state[2] = E_fric
     e_state[3] = E_z
+    e_state[4] = E_ax
     return status, n_ev, n_sub, k_done
 
 
 @_JIT
-def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy):
+def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, out_energy):
     """Row ``k`` of the energy output: input, kinetic (structure and pallets, relative to the
-    ground), strain (½ qᵀ kd q plus the hinges' correction work), damping, friction."""
+    ground), strain (½ qᵀ kd q plus the hinges' correction work and the P-Δ force's work),
+    damping, friction, the P-Δ force's work alone."""
     kin = 0.5 * np.dot(T0[1], T0[1])
     for p in range(mass.shape[0]):
         kin += 0.5 * mass[p] * (S0[1, 2 * p] ** 2 + S0[1, 2 * p + 1] ** 2)
-    strain = E_z
+    strain = E_z + E_ax
     for i in range(kd.shape[0]):
         strain += 0.5 * kd[i] * T0[0, i] * T0[0, i]
     out_energy[k, 0] = E_in
@@ -371,3 +404,4 @@ def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, out_energy):
     out_energy[k, 2] = strain
     out_energy[k, 3] = E_damp
     out_energy[k, 4] = E_fric
+    out_energy[k, 5] = E_ax

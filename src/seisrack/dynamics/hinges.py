@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from seisrack.dynamics import _hysteresis as hy
+from seisrack.dynamics.axial import AxialPDelta
 from seisrack.errors import InputError
 
 
@@ -23,13 +24,16 @@ class Hinges:
     law: (n_h,) int law code (``HYST_*``); par: (n_h, HYST_NPAR) law parameters;
     theta0: (n_h,) [rad] rotation in the static state the motion starts from (the engine's
     displacements are measured from it: e.g. the rack under gravity), default 0. The laws
-    start there as if loaded monotonically from zero."""
+    start there as if loaded monotonically from zero.
+    axial: the P-Δ of the members' axial-force change (:mod:`seisrack.dynamics.axial`), the
+    structure's other nonlinear internal force, or None (sliders in the plane only)."""
 
     dofs: np.ndarray
     k: np.ndarray
     law: np.ndarray
     par: np.ndarray
     theta0: np.ndarray | None = None
+    axial: AxialPDelta | None = None
 
     def __post_init__(self) -> None:
         dofs = np.asarray(self.dofs, dtype=np.int64).reshape(-1, 2)
@@ -97,6 +101,9 @@ class Hinges:
 
     def check(self, n: int) -> None:
         """DOFs within the structure's ``n`` DOFs."""
+        if self.axial is not None and self.axial.n_dof != n:
+            raise InputError("hinges.axial", f"operators on {self.axial.n_dof} DOFs",
+                             f"operators on the structure's {n} DOFs")
         d = self.dofs
         bad = (d[:, 0] < 0) | (d[:, 0] >= n) | (d[:, 1] < -1) | (d[:, 1] >= n)
         if np.any(bad):

@@ -20,6 +20,7 @@ import numpy as np
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics._store import keep_index
+from seisrack.dynamics.axial import no_axial
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
 from seisrack.dynamics.kernels import scheme_kernel, writable
@@ -34,6 +35,7 @@ _STATUS = {
     **STEP_STATUS,
     2: "too many events inside one step (reduce dt)",
     5: "the sliding directions did not converge inside a step (reduce dt)",
+    6: "the P-Δ of the current axial forces did not settle inside a step (reduce dt)",
 }
 
 
@@ -112,14 +114,15 @@ def run_planar_scheme(
     h_k, h_law, h_par, h_th0 = (writable(a[:nh]) for a in
                                 (hinges.k, hinges.law, hinges.par, hinges.theta0))
     HW = np.zeros((4, nh))
-    e_state = np.zeros(4)
+    ax = no_axial(nb) if hinges.axial is None else hinges.axial.reduced(phi)
+    e_state = np.zeros(5)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
     bufs = (np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
-            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 5 if track_energy else 0)))
+            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 6 if track_energy else 0)))
     keep_idx = keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
     kept_N = np.empty((keep_idx.size, m))
@@ -138,7 +141,7 @@ def run_planar_scheme(
                 kd, cd, Co, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
                 _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
-                stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8])
+                stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8], *ax)
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
@@ -168,6 +171,9 @@ def run_planar_scheme(
     energy = {nm: ken[:, c].copy() for c, nm in
               enumerate(("input", "kinetic", "strain", "damping", "friction"))
               } if track_energy else {}
+    if track_energy and hinges.axial is not None:  # its work apart: not a strain energy
+        energy["p_delta"] = ken[:, 5].copy()
+        energy["strain"] -= energy["p_delta"]
     if nh and track_energy:
         energy["strain"], energy["hysteresis"] = energy_split(
             energy["strain"], kq, w2, kq @ Q.T + h_th0, khm, h_k, h_th0,

@@ -68,6 +68,8 @@ class TimeHistory:
     normal: (n_t, m) [N] normal force; stuck: (n_t, m) bool;
     energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction, and with
     nonlinear hinges "hysteresis" (their dissipated work; "strain" is then the recoverable part);
+    with the P-Δ of the current axial forces "p_delta" (the work of that force, which is not
+    the gradient of a potential: :mod:`seisrack.dynamics.axial`);
     hinge_moment: (n_t, n_h) [N·m] and :attr:`hinge_rotation` of the nonlinear hinges.
     Here ``n_t`` counts the *kept* samples: with ``simulate(save_every=k)`` they are the steps
     listed in ``sample_index`` (every k-th and the last), at times ``t``. ``basis`` describes
@@ -163,13 +165,15 @@ class TimeHistory:
             + e["damping"]
             + e["friction"]
             + e.get("hysteresis", 0.0)
+            + e.get("p_delta", 0.0)
         )
         scale = max(
             float(np.max(np.abs(e["input"]))),
             float(np.max(e["kinetic"])),
             float(np.max(e["strain"])),
             float(np.max(np.abs(e["damping"]))) + float(np.max(np.abs(e["friction"])))
-            + float(np.max(np.abs(e.get("hysteresis", 0.0)))),
+            + float(np.max(np.abs(e.get("hysteresis", 0.0))))
+            + float(np.max(np.abs(e.get("p_delta", 0.0)))),
             1e-300,
         )
         return float(np.max(np.abs(lhs - rhs)) / scale)

@@ -52,8 +52,8 @@ import scipy.sparse.linalg as sla
 
 from seisrack.fe.assembly import scatter, symmetric_csr
 from seisrack.fe.elements import to_global
-from seisrack.fe.frame_elements import local_frames
-from seisrack.fe.mesh import FloatArray, FrameMesh
+from seisrack.fe.frame_elements import end_force_maps, local_frames
+from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
 from seisrack.fe.recovery import element_end_forces
 from seisrack.fe.stability import symmetric_lu
 
@@ -182,3 +182,57 @@ def critical_load_factor(K_E: sp.spmatrix, K_G: sp.spmatrix) -> float:
     if mu <= MU_NONE:
         return float("inf")
     return 1.0 / mu
+
+
+def axial_operator(mesh: FrameMesh) -> sp.csr_matrix:
+    """(n_el + n_tr, n_dof) the axial forces of :func:`axial_forces` (beam-columns, then
+    bars; tension positive) per unit free-DOF displacement: ``axial_operator(mesh) @ u``
+    equals them, as the concatenation of the two arrays."""
+    n_el, nt = mesh.n_el, mesh.trusses.shape[0]
+    kt = end_force_maps(mesh).kt[:, _AXIAL_J[2 * mesh.ndf], :]  # (n_el, 2 ndf)
+    rows = [np.repeat(np.arange(n_el), kt.shape[1])]
+    cols = [mesh.element_dofs.ravel()]
+    vals = [kt.ravel()]
+    if nt:
+        X = mesh.nodes
+        d = X[mesh.trusses[:, 1]] - X[mesh.trusses[:, 0]]
+        L = np.linalg.norm(d, axis=1)
+        c = (mesh.truss_E * mesh.truss_A / L)[:, None] * d / L[:, None]  # EA/L n
+        rows.append(n_el + np.repeat(np.arange(nt), 2 * mesh.ndm))
+        cols.append(mesh.truss_dofs.ravel())
+        vals.append(np.concatenate([-c, c], axis=1).ravel())
+    r, c_, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    keep = c_ >= 0
+    return sp.csr_matrix((v[keep], (r[keep], c_[keep])), shape=(n_el + nt, mesh.n_dof))
+
+
+def unit_geometric_factors(mesh: FrameMesh, form: GeometricForm = "consistent"
+                           ) -> tuple[sp.csr_matrix, IntArray, FloatArray]:
+    """The members' geometric stiffness per unit axial force by its eigenpairs: (rows
+    (n_g, n_dof), owner (n_g,), scale (n_g,)) with ``K_G(N, N_bar) = Σ_g n_{owner g} scale_g
+    rows_gᵀ rows_g`` for ``n = [N, N_bar]`` (owner indexes the rows of
+    :func:`axial_operator`); rank 2 per member in 3D with the chord form, 6 with the
+    consistent one (each plane's block but its rigid translation), 2 per bar (``ndm − 1``)."""
+    blocks = [(to_global(local_geometric_stiffness(np.ones(mesh.n_el), mesh.lengths, form,
+                                                   mesh.ndm), local_frames(mesh)),
+               mesh.element_dofs, 0)]
+    if mesh.trusses.shape[0]:
+        blocks.append((bar_geometric_stiffness(mesh, np.ones(mesh.trusses.shape[0])),
+                       mesh.truss_dofs, mesh.n_el))
+    rows, cols, vals, owner, scale = [], [], [], [], []
+    n_g = 0
+    for kb, dofs, first in blocks:
+        w, v = np.linalg.eigh(kb)
+        big = np.abs(w) > 1e-9 * np.max(np.abs(w), axis=1, keepdims=True)
+        e, i = np.nonzero(big)
+        vec = v[e, :, i]  # (k, size): the eigenvectors of the kept pairs
+        rows.append(n_g + np.repeat(np.arange(e.size), vec.shape[1]))
+        cols.append(dofs[e].ravel())
+        vals.append(vec.ravel())
+        owner.append(first + e)
+        scale.append(w[e, i])
+        n_g += e.size
+    r, c, val = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+    keep = c >= 0
+    G = sp.csr_matrix((val[keep], (r[keep], c[keep])), shape=(n_g, mesh.n_dof))
+    return G, np.concatenate(owner).astype(np.int64), np.concatenate(scale)

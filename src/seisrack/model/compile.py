@@ -21,13 +21,14 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from seisrack.dynamics.axial import AxialPDelta
 from seisrack.errors import InputError
 from seisrack.fe import damping as fe_damping
 from seisrack.fe import geometric
 from seisrack.fe.assembly import assemble_sparse, symmetric_csr
 from seisrack.fe.mesh import FloatArray, FrameMesh
 from seisrack.fe.modal import modal_from_matrices
-from seisrack.fe.stability import is_positive_definite
+from seisrack.fe.stability import is_positive_definite, symmetric_lu
 from seisrack.model.features import check_features
 from seisrack.model.frame_model import FrameModel, read_only
 from seisrack.model.pallet_layout import pallet_layout
@@ -66,8 +67,9 @@ def compile_rack(spec: RackSpec) -> FrameModel:
     r_z = _influence(nd[:, 2], mesh.n_dof) if mesh.ndm == 3 else None
     lam_cr = None
     K_E = K
+    axial = None
     if spec.second_order.p_delta:
-        K, lam_cr = _p_delta(spec, mesh, K, M, r_y)
+        K, lam_cr, axial = _p_delta(spec, mesh, K, M, r_y)
     horizontal = np.concatenate([p_dofs[:, :, d].ravel() for d in range(len(slots))])
     Mt = M + _diagonal(horizontal, np.tile(share, len(slots)), mesh.n_dof)  # pallets attached
     a0, a1 = _damping(spec, K, Mt, r_x, r_y)
@@ -102,7 +104,7 @@ def compile_rack(spec: RackSpec) -> FrameModel:
         upright_below_elements=rm.upright_below_elements,
         upright_above_elements=rm.upright_above_elements, member_mass=mesh.member_mass,
         g=spec.g, title=spec.title, critical_load_factor=lam_cr, n_rows=spec.geometry.rows,
-        frame_z=np.array(spec.geometry.frame_z),
+        frame_z=np.array(spec.geometry.frame_z), axial_p_delta=axial,
         **_hinges(spec, mesh, K, M, r_y),
     ))
 
@@ -269,17 +271,19 @@ def _check_stable(K: sp.csr_matrix, spec: RackSpec) -> None:
 
 
 def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matrix,
-             r_y: FloatArray) -> tuple[sp.csr_matrix, float]:
-    """K_E + K_G and the critical load factor; InputError if the gravity load buckles the rack.
-    A plane or a space rack (members in both bending planes, bracing bars included:
-    :mod:`seisrack.fe.geometric`).
+             r_y: FloatArray) -> tuple[sp.csr_matrix, float, AxialPDelta | None]:
+    """K_E + K_G, the critical load factor and, with ``axial = "current"``, the P-Δ of the
+    axial forces' change (:mod:`seisrack.dynamics.axial`); InputError if the gravity load
+    buckles the rack. A plane or a space rack (members in both bending planes, bracing bars
+    included: :mod:`seisrack.fe.geometric`).
 
     Gravity load F = -g·M·r_y: with the consistent member mass this is the consistent load
     vector of the members' self weight (a rigid vertical translation is exact in the element's
     shape functions), plus each pallet's weight on its support nodes' uy DOFs.
     """
     form = spec.second_order.form
-    N, N_bar = geometric.static_axial_forces(mesh, K_E, -spec.g * (M @ r_y))
+    u_g = symmetric_lu(K_E).solve(-spec.g * (M @ r_y))  # the static state under gravity
+    N, N_bar = geometric.axial_forces(mesh, u_g)
     K_G = geometric.geometric_stiffness(mesh, N, form, N_bar)  # bars: their string stiffness
     lam = geometric.critical_load_factor(K_E, K_G)
     if lam <= 1.0:
@@ -291,7 +295,11 @@ def _p_delta(spec: RackSpec, mesh: FrameMesh, K_E: sp.csr_matrix, M: sp.csr_matr
                  "buckle under the members' and pallets' weight. Use stiffer uprights, base "
                  "plates or connectors, or lighter pallets")
     log.info("P-Δ (%s form): critical load factor %.4g", form, lam)
-    return symmetric_csr(K_E + K_G), lam
+    axial = None
+    if spec.second_order.axial == "current":
+        rows, owner, scale = geometric.unit_geometric_factors(mesh, form)
+        axial = AxialPDelta(geometric.axial_operator(mesh), rows, owner, scale, rows @ u_g)
+    return symmetric_csr(K_E + K_G), lam, axial
 
 
 def _damping(spec: RackSpec, K: sp.csr_matrix, Mt: sp.csr_matrix, r_x: FloatArray,

@@ -22,6 +22,7 @@ FEATURES: dict[str, tuple[int, ...]] = {
     "exact modal propagators (method exact)": (2,),
     "a cross-aisle ground motion component": (3,),
     "an incidence angle of the horizontal components": (3,),
+    "P-Δ of the current axial forces ([second_order] axial)": (3,),
 }
 
 
@@ -31,6 +32,7 @@ ENGINE_LACKS: dict[str, tuple[str, ...]] = {
     "local": (
         "nonlinear connections ([hysteresis])",
         "velocity-dependent friction (friction_rate)",
+        "P-Δ of the current axial forces ([second_order] axial)",
         "a choice of time integration (method)",
         "a choice of structure basis (basis)",
     ),
@@ -75,6 +77,9 @@ def check_features(spec: Any) -> None:
         require("velocity-dependent friction (friction_rate)", ndm,
                 f"pallets[{rates[0]}].friction_rate", spec.pallets[rates[0]].friction_rate,
                 source=src)
+    if spec.second_order.axial == "current":
+        require("P-Δ of the current axial forces ([second_order] axial)", ndm,
+                "second_order.axial", "current", source=src)
     if ndm == 3:
         _check_sections_3d(spec)
 
@@ -119,6 +124,9 @@ def check_engine(engine: str, model: Any, *, method: str = "auto",
     if model.nonlinear_hinges:
         require_engine("nonlinear connections ([hysteresis])", engine, "hysteresis",
                        "a nonlinear law")
+    if model.axial_p_delta is not None:
+        require_engine("P-Δ of the current axial forces ([second_order] axial)", engine,
+                       "second_order.axial", "current")
     rates = np.flatnonzero(np.asarray(model.pallet_friction_rate) != 0)
     if rates.size:
         j = int(rates[0])

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from seisrack.dynamics.axial import AxialPDelta
 from seisrack.fe.mesh import FloatArray, FrameMesh, IntArray
 from seisrack.model.pallet_layout import PalletLayout
 from seisrack.model.rack_mesh import BEAM, UPRIGHT  # noqa: F401  (re-exported)
@@ -154,6 +155,9 @@ class FrameModel:
     damping_stiffness_term: str = "elastic"
     n_rows: int = 1
     frame_z: FloatArray | None = None
+    #: ``[second_order] axial = "current"``: the P-Δ of the axial forces' change during the
+    #: motion (:mod:`seisrack.dynamics.axial`), else None
+    axial_p_delta: AxialPDelta | None = None
 
     # ------------------------------------------------------------------ dimension
     @property

@@ -442,8 +442,15 @@ def _second_order(t: Table) -> SecondOrder:
     form = t.string("form", "consistent")
     if form not in ("consistent", "p_delta_only"):
         raise t.error("form", form, '"consistent" or "p_delta_only"')
-    t.finish(("p_delta", "form"))
-    return SecondOrder(p_delta=p_delta, form=form)  # type: ignore[arg-type]
+    axial = t.string("axial", "gravity")
+    if axial not in ("gravity", "current"):
+        raise t.error("axial", axial, '"gravity" (the gravity axial forces, held constant) or '
+                      '"current" (gravity plus their change during the motion)')
+    if axial == "current" and not p_delta:
+        raise t.error("axial", axial, '"gravity" while p_delta is false (the axial forces '
+                      'act through the geometric stiffness: set p_delta = true)')
+    t.finish(("p_delta", "form", "axial"))
+    return SecondOrder(p_delta=p_delta, form=form, axial=axial)  # type: ignore[arg-type]
 
 
 def _hysteresis(t: Table, connections: Connections) -> Hysteresis:

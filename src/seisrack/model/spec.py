@@ -192,10 +192,16 @@ class SecondOrder:
     ``form``: ``"consistent"`` (cubic-Hermite geometric stiffness, P-Δ and P-δ) or
     ``"p_delta_only"`` (the chord term N/L, as OpenSees' ``geomTransf PDelta``); see
     :mod:`seisrack.fe.geometric`.
+    ``axial``: which axial forces the geometric stiffness carries during the time history:
+    ``"gravity"`` (default: those of the gravity load, held constant, so K stays linear) or
+    ``"current"`` (gravity plus the change the motion causes, N(t) = N_g + ΔN(u(t)), as
+    OpenSees' ``geomTransf PDelta`` does: an uplifting upright loses its P-Δ, a more
+    compressed one gains; :mod:`seisrack.dynamics.axial`).
     """
 
     p_delta: bool = False
     form: Literal["consistent", "p_delta_only"] = "consistent"
+    axial: Literal["gravity", "current"] = "gravity"
 
 
 @dataclass(frozen=True)
