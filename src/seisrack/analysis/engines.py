@@ -115,7 +115,7 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
         progress=progress, max_memory=max_memory, throw=throw, backend=backend)
     d = np.asarray(model.pallet_dofs)
     return TimeHistory(
-        t=hist.t, q=hist.q, qd=hist.v, qdd=hist.a, phi=prepared.basis.matrix().tocsr(),
+        t=hist.t, q=hist.q, qd=hist.v, qdd=hist.a, phi=prepared.basis.phi,
         slider_u=None, slider_v=None, sliding=sq(hist.sliding), friction=sq(hist.friction),
         normal=hist.normal, stuck=hist.stuck, slider_dof=d[:, 0, 0] if line else d[:, :, 0],
         events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,

@@ -103,13 +103,12 @@ def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: boo
             from seisrack.dynamics.local.racks import rack_basis
 
             bas = rack_basis(model, sliders, vertical=vertical)
-            phi = bas.matrix().tocsr()
         else:
             hinges = rack_hinges(model)
             bas = choose_basis(basis, model.M_sparse, model.K_sparse, sliders, model.influence,
                                rv=model.r_y if vertical else None, hinges=hinges)
-            phi = bas.phi
-        hit = cache[key] = PreparedRun(basis=bas, ops=rack_operators(model, phi, design=design),
+        hit = cache[key] = PreparedRun(basis=bas,
+                                       ops=rack_operators(model, bas.phi, design=design),
                                        hinges=hinges, sliders=sliders, vertical=vertical,
                                        n_dof=model.n_dof, engine=engine)
     return hit
