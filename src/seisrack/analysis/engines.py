@@ -12,10 +12,12 @@ accelerations carry the period-2h residue of the stiff directions:
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
-from seisrack.analysis.prepare import RIGID_MU, PreparedRun, rack_sliders
+from seisrack.analysis.prepare import RIGID_MU, PreparedRun
+from seisrack.dynamics import PlanarSliders, Sliders
 from seisrack.dynamics._chunk import Chunk
 from seisrack.dynamics.engine import simulate
 from seisrack.dynamics.local.sliders import LocalSliders
@@ -36,47 +38,67 @@ def simulate_rack(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
     or None. ``companion``: the ``on_chunk`` of a second run with every pallet rigidly held
     (friction :data:`~seisrack.analysis.prepare.RIGID_MU`, peaks only, the main run's
     method), made when the rack carries pallets. Returns the main run's history."""
-    hist = None
-    for mu, observer in ((None, on_chunk), (RIGID_MU, companion)):
-        main = mu is None
-        if not main and (observer is None or not model.n_pallets):
-            break
-        kw = dict(on_chunk=observer, progress=progress if main else None,
-                  save_every=save_every if main else None, max_memory=max_memory,
-                  throw=throw, backend=backend)
-        sliders = rack_sliders(model, mu, prepared.engine)
-        if prepared.engine == "local":
-            run = simulate_rack_local(model, prepared, sliders, ag, av, h, **kw)
-        else:
-            try:
-                run = simulate(
-                    model.M_sparse, model.C_sparse, model.K_sparse, sliders, dt=h,
-                    ground_accel=ag, influence=np.column_stack(model.influence),
-                    vertical_accel=av, vertical_influence=None if av is None else model.r_y,
-                    g=model.g, basis=prepared.basis, hinges=prepared.hinges,
-                    track_energy=track_energy and main,
-                    method=method if main or hist.method != "exact" else "exact", **kw)
-            except InputError as exc:
-                if not exc.field.startswith("sliders.friction_rate["):
-                    raise
-                j = int(exc.field.split("[")[1].rstrip("]"))
-                raise InputError(
-                    f"friction_rate of pallet {j + 1} (level {model.pallet_level[j] + 1})",
-                    exc.value, exc.allowed, source=getattr(model, "title", None) or None,
-                    hint=exc.hint) from None
-        hist = run if main else hist
+    kw = dict(max_memory=max_memory, throw=throw, backend=backend)
+    if prepared.engine == "local":
+        run, opts = simulate_rack_local, {}
+    else:
+        run, opts = simulate_rack_default, dict(method=method, track_energy=track_energy)
+    hist = run(model, prepared, ag, av, h, on_chunk=on_chunk, progress=progress,
+               save_every=save_every, **opts, **kw)
+    if companion is not None and model.n_pallets:
+        if opts:  # the main run's method, no energy
+            opts = dict(method="exact" if hist.method == "exact" else method, track_energy=False)
+        run(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=companion, save_every=None,
+            **opts, **kw)
     return hist
 
 
-def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: LocalSliders,
-                        ag: np.ndarray, av: np.ndarray | None, h: float, *,
+def run_sliders(prepared: PreparedRun, model: FrameModel, mu: float | None = None
+                ) -> Sliders | PlanarSliders | LocalSliders:
+    """The prepared pallets with the run's friction: ``model``'s (a study's runs differ in
+    their friction only), or ``mu`` for every coefficient (the rigid companion, Coulomb)."""
+    kw = dict(mu_static=model.pallet_mu_static if mu is None else mu,
+              mu_dynamic=model.pallet_mu_dynamic if mu is None else mu)
+    if isinstance(prepared.sliders, Sliders):
+        kw["friction_rate"] = model.pallet_friction_rate if mu is None else 0.0
+    return replace(prepared.sliders, **kw)
+
+
+def simulate_rack_default(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
+                          av: np.ndarray | None, h: float, *, mu: float | None = None,
+                          on_chunk: Callable[[Chunk], None] | None = None,
+                          progress: Callable[[int], None] | None = None,
+                          save_every: int | None = 1, track_energy: bool = True,
+                          method: str = "auto", max_memory: float | None = None,
+                          throw: bool = True, backend: str = "auto") -> TimeHistory:
+    """One run of the default engine (:func:`seisrack.dynamics.simulate`) on ``model``, its
+    pallets' friction ``mu`` as in :func:`run_sliders`; arguments as :func:`simulate_rack`."""
+    try:
+        return simulate(
+            model.M_sparse, model.C_sparse, model.K_sparse, run_sliders(prepared, model, mu),
+            dt=h, ground_accel=ag, influence=np.column_stack(model.influence),
+            vertical_accel=av, vertical_influence=None if av is None else model.r_y, g=model.g,
+            basis=prepared.basis, hinges=prepared.hinges, track_energy=track_energy,
+            method=method, on_chunk=on_chunk, progress=progress, save_every=save_every,
+            max_memory=max_memory, throw=throw, backend=backend)
+    except InputError as exc:
+        if not exc.field.startswith("sliders.friction_rate["):
+            raise
+        j = int(exc.field.split("[")[1].rstrip("]"))
+        raise InputError(
+            f"friction_rate of pallet {j + 1} (level {model.pallet_level[j] + 1})",
+            exc.value, exc.allowed, source=getattr(model, "title", None) or None,
+            hint=exc.hint) from None
+
+
+def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
+                        av: np.ndarray | None, h: float, *, mu: float | None = None,
                         on_chunk: Callable[[Chunk], None] | None = None,
                         progress: Callable[[int], None] | None = None,
                         save_every: int | None = 1, max_memory: float | None = None,
                         throw: bool = True, backend: str = "auto") -> TimeHistory:
-    """One run of the local engine on ``model``: ``ag`` (n_t, n_dir) [m/s²] the horizontal
-    ground accelerations on the analysis grid (step ``h``), ``av`` the vertical one or None;
-    ``sliders``: the pallets (:func:`~seisrack.analysis.prepare.rack_sliders`)."""
+    """One run of the local engine on ``model``, its pallets' friction ``mu`` as in
+    :func:`run_sliders`; arguments as :func:`simulate_rack`."""
     from seisrack.dynamics.local.scheme import run_local_scheme
 
     line = model.n_dir == 1
@@ -87,13 +109,13 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, sliders: Local
                        sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
 
     hist = run_local_scheme(
-        model.M_sparse, sliders, prepared.basis, dt=h, ag=ag, r=np.array(model.influence),
-        av=av, rv=None if av is None else model.r_y, g=model.g, save_every=save_every,
-        on_chunk=None if on_chunk is None else chunk_cb, progress=progress,
-        max_memory=max_memory, throw=throw, backend=backend)
+        model.M_sparse, run_sliders(prepared, model, mu), prepared.basis, dt=h, ag=ag,
+        r=np.array(model.influence), av=av, rv=None if av is None else model.r_y, g=model.g,
+        save_every=save_every, on_chunk=None if on_chunk is None else chunk_cb,
+        progress=progress, max_memory=max_memory, throw=throw, backend=backend)
     d = np.asarray(model.pallet_dofs)
     return TimeHistory(
-        t=hist.t, q=hist.q, qd=hist.v, qdd=hist.a, phi=prepared.basis.matrix().tocsr(),
+        t=hist.t, q=hist.q, qd=hist.v, qdd=hist.a, phi=prepared.basis.phi,
         slider_u=None, slider_v=None, sliding=sq(hist.sliding), friction=sq(hist.friction),
         normal=hist.normal, stuck=hist.stuck, slider_dof=d[:, 0, 0] if line else d[:, :, 0],
         events=hist.events, energy=hist.energy, status=hist.status, backend=hist.backend,

@@ -88,10 +88,8 @@ def rack_operators(model, phi: np.ndarray, design: bool = True) -> RackOperators
     """Project the level-averaging and force-recovery operators of ``model`` onto ``phi``
     (dense, or sparse for the local engine's basis)."""
     from seisrack.fe.recovery import rack_operators as element_operators
-    from seisrack.fe.recovery import recovery_operators
 
-    # one pass over the members for both operator sets
-    ops, des = element_operators(model) if design else (recovery_operators(model), None)
+    ops, des = element_operators(model, design)  # one pass over the members
     level = tuple(np.column_stack([_level_mean(phi, d) for d in dofs])
                   for dofs in model.level_dofs)
 

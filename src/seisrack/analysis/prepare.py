@@ -4,8 +4,9 @@ The basis the engine integrates in (default engine:
 :func:`seisrack.dynamics.run_basis.choose_basis`, every mode of a small rack, a load-dependent
 Ritz basis of a large one; local engine: :func:`seisrack.dynamics.local.racks.rack_basis`, with
 its measured error), the recovery and design operators projected onto it
-(:mod:`seisrack.analysis.operators`), and the rack's hinges. A study runs one model under many
-records and frictions: it prepares once and hands the :class:`PreparedRun` to every
+(:mod:`seisrack.analysis.operators`), the rack's hinges and its pallets as the engine's sliders
+(:func:`rack_sliders`, built once: a run only sets their friction). A study runs one model
+under many records and frictions: it prepares once and hands the :class:`PreparedRun` to every
 :func:`~seisrack.analysis.run_rack`. Friction does not enter what is prepared, so a run may use
 a model whose pallet friction differs from the prepared one's.
 """
@@ -37,7 +38,9 @@ class PreparedRun:
     """The shared part of the runs of one rack (arrays read-only).
 
     basis: the engine's basis; ops: the rack operators projected onto it; hinges: the rack's
-    nonlinear hinges (None when every connection is elastic); vertical: whether the basis holds
+    nonlinear hinges (None when every connection is elastic); sliders: the pallets as the
+    engine's sliders (:func:`rack_sliders`, with the prepared model's friction: each run sets
+    its own, :func:`seisrack.analysis.engines.run_sliders`); vertical: whether the basis holds
     the vertical load (runs with a vertical component); n_dof: the model's size (checked);
     engine: the engine the basis is for ("default" or "local").
     """
@@ -45,6 +48,7 @@ class PreparedRun:
     basis: Basis
     ops: RackOperators
     hinges: Hinges | None
+    sliders: Sliders | PlanarSliders | LocalSliders
     vertical: bool
     n_dof: int
     engine: str = "default"
@@ -53,20 +57,17 @@ class PreparedRun:
         _locked(self)  # shared by every run of the model
 
 
-def rack_sliders(model: FrameModel, mu: float | None = None,
+def rack_sliders(model: FrameModel,
                  engine: str = "default") -> Sliders | PlanarSliders | LocalSliders:
-    """The pallets of ``model`` as ``engine``'s sliders: along a line when the rack has one
-    horizontal direction (their supports' down-aisle DOF), in the plane when it has two (their
-    front and rear supports' x and z DOFs); the local engine's take every support and
-    direction. ``mu`` replaces every friction coefficient (the rigid companion run)."""
-    mus = model.pallet_mu_static if mu is None else mu
-    mud = model.pallet_mu_dynamic if mu is None else mu
-    d = model.pallet_dofs
+    """The pallets of ``model`` as ``engine``'s sliders, with the model's friction: along a
+    line when the rack has one horizontal direction (their supports' down-aisle DOF), in the
+    plane when it has two (their front and rear supports' x and z DOFs); the local engine's
+    take every support and direction."""
+    mus, mud, d = model.pallet_mu_static, model.pallet_mu_dynamic, model.pallet_dofs
     if engine == "local":
         return LocalSliders(np.asarray(d), model.pallet_mass, mus, mud)
     if model.n_dir == 1:
-        return Sliders(d[:, 0, 0], model.pallet_mass, mus, mud,
-                       model.pallet_friction_rate if mu is None else 0.0)
+        return Sliders(d[:, 0, 0], model.pallet_mass, mus, mud, model.pallet_friction_rate)
     return PlanarSliders(d[:, :, 0], d[:, :, 1], model.pallet_mass, mus, mud)
 
 
@@ -97,31 +98,36 @@ def prepare_run(model: FrameModel, *, basis: str | Basis = "auto", vertical: boo
     key = (engine, None if given else basis, bool(vertical), bool(design))
     hit = cache.get(key)
     if hit is None:
-        hinges, sliders = None, rack_sliders(model)
+        hinges, sliders = None, rack_sliders(model, engine)
         if engine == "local":
             from seisrack.dynamics.local.racks import rack_basis
 
-            bas = rack_basis(model, vertical=vertical)
-            phi = bas.matrix().tocsr()
+            bas = rack_basis(model, sliders, vertical=vertical)
         else:
             hinges = rack_hinges(model)
             bas = choose_basis(basis, model.M_sparse, model.K_sparse, sliders, model.influence,
                                rv=model.r_y if vertical else None, hinges=hinges)
-            phi = bas.phi
-        hit = cache[key] = PreparedRun(basis=bas, ops=rack_operators(model, phi, design=design),
-                                       hinges=hinges, vertical=vertical, n_dof=model.n_dof,
-                                       engine=engine)
+        hit = cache[key] = PreparedRun(basis=bas,
+                                       ops=rack_operators(model, bas.phi, design=design),
+                                       hinges=hinges, sliders=sliders, vertical=vertical,
+                                       n_dof=model.n_dof, engine=engine)
     return hit
 
 
 def checked_prepared(prepared: PreparedRun, model: FrameModel, engine: str) -> PreparedRun:
-    """``prepared`` if it was prepared for ``model``'s size and for ``engine``."""
+    """``prepared`` if it was prepared for ``model``'s size, its pallets' masses and for
+    ``engine``."""
     if not isinstance(prepared, PreparedRun):
         raise InputError("prepared", type(prepared).__name__,
                          "a seisrack.analysis.PreparedRun (prepare_run(model))")
     if prepared.n_dof != model.n_dof:
         raise InputError("prepared", f"a prepared run of {prepared.n_dof} DOFs",
                          f"prepare_run(model) of this model ({model.n_dof} DOFs)")
+    if not np.array_equal(prepared.sliders.mass, model.pallet_mass):
+        raise InputError("prepared", f"a prepared run of {prepared.sliders.count} pallets "
+                         f"({float(np.sum(prepared.sliders.mass)):g} kg)",
+                         f"prepare_run(model) of this model's {model.n_pallets} pallets "
+                         f"({float(np.sum(model.pallet_mass)):g} kg)")
     if prepared.engine != engine:
         raise InputError("prepared", f"a run prepared for the {prepared.engine} engine",
                          f'prepare_run(model, engine="{engine}") for engine="{engine}"')

@@ -55,8 +55,7 @@ def member_operators(model: Any) -> tuple[list[NamedOperator], str]:
     """
     from seisrack.fe import recovery
 
-    rec = recovery.recovery_operators(model)
-    des = recovery.design_operators(model)
+    rec, des = recovery.rack_operators(model)  # one pass over the members
     n_up, n_lev = rec.n_upright, rec.n_level
     out = [NamedOperator("upright_axial_force", des.axial, des.axial_labels, "N",
                          "upright axial force, tension positive, at the base and below each "

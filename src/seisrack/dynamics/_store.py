@@ -1,6 +1,6 @@
 """Buffers of the engine: one chunk at full rate, and the samples a run keeps
 (:func:`keep_index`: every ``save_every``-th step and the last one), with the memory they take
-checked before anything is allocated (:func:`check_memory`)."""
+checked before anything is allocated (:func:`check_kept_memory`)."""
 
 from __future__ import annotations
 
@@ -50,12 +50,21 @@ def check_memory(n_steps: int, save_every: int | None, chunk: int, nb: int, m: i
     """Refuse a run of ``n_steps`` keeping every ``save_every``-th sample of ``nb``
     coordinates and ``m`` slider columns whose histories and buffers would not fit, before
     allocating them."""
-    n_keep, n_t = kept_samples(n_steps, save_every), n_steps + 1
     per_row = 8 * (3 * nb + 4 * m + 5) + m
-    need = n_keep * (per_row + 8 * m) + (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * n_t
-    refuse_over_budget(need, max_memory, f"{n_t - 1} steps keeping {n_keep} samples of {nb} "
-                       f"coordinates and {m} sliders",
-                       "Keep fewer samples (save_every=k, or None with on_chunk for peaks only)")
+    check_kept_memory(n_steps, save_every, per_row + 8 * m,
+                      (chunk + 1) * (per_row + 8 * (nb + 2 * m)) + 8 * 4 * (n_steps + 1),
+                      max_memory, f"{nb} coordinates and {m} sliders",
+                      "Keep fewer samples (save_every=k, or None with on_chunk for peaks only)")
+
+
+def check_kept_memory(n_steps: int, save_every: int | None, per_sample: float, fixed: float,
+                      max_memory: float | None, what: str, hint: str) -> None:
+    """Refuse (:func:`refuse_over_budget`), before anything is allocated, a run of ``n_steps``
+    keeping every ``save_every``-th sample (:func:`kept_samples`) at ``per_sample`` bytes each,
+    with ``fixed`` bytes of buffers; ``what``: what a sample holds (for the message)."""
+    n_keep = kept_samples(n_steps, save_every)
+    refuse_over_budget(n_keep * per_sample + fixed, max_memory,
+                       f"{n_steps} steps keeping {n_keep} samples of {what}", hint)
 
 
 def refuse_over_budget(need: float, max_memory: float | None, what: str, hint: str) -> None:

@@ -67,3 +67,8 @@ def writable(a: np.ndarray) -> np.ndarray:
     read-only arrays (a compiled model's arrays are locked), so the kernel always gets these."""
     a = np.ascontiguousarray(a)
     return a if a.flags.writeable else a.copy()
+
+
+def writable_all(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`writable` of each of a kernel's inputs, in one call."""
+    return tuple(writable(a) for a in arrays)

@@ -23,7 +23,7 @@ from seisrack.dynamics._store import keep_index
 from seisrack.dynamics.axial import no_axial
 from seisrack.dynamics.basis import Basis
 from seisrack.dynamics.hinges import Hinges, energy_split, no_hinges
-from seisrack.dynamics.kernels import scheme_kernel, writable
+from seisrack.dynamics.kernels import scheme_kernel, writable_all
 from seisrack.dynamics.results import STEP_STATUS, TimeHistory, recorded_events, run_status
 from seisrack.dynamics.sliders import PlanarSliders
 from seisrack.errors import InputError
@@ -95,12 +95,15 @@ def run_planar_scheme(
     ser = np.column_stack(series) if series else np.zeros((n_t, 0))
     gz = g + (av if av is not None else np.zeros(n_t))
     P = sliders.support_matrix(phi)
+    Q = hinges.operator(phi)[:nh]
+    hst = hinges.initial_state()[:nh]
     mod, used = _kernel(backend)
+    # writable: a read-only array (a compiled model's) is another numba specialisation
+    mass, mus, mud, kd, h_k, h_law, h_par, h_th0 = writable_all(
+        sliders.mass, sliders.mu_static, sliders.mu_dynamic, w2,
+        *(a[:nh] for a in (hinges.k, hinges.law, hinges.par, hinges.theta0)))
     agx, agz = np.ascontiguousarray(ag[:, 0]), np.ascontiguousarray(ag[:, 1])
 
-    mass, mus, mud = (writable(a) for a in (sliders.mass, sliders.mu_static,
-                                                  sliders.mu_dynamic))
-    kd = writable(w2)
     T_state = np.zeros((3, nb))
     S_state = np.zeros((6, 2 * m))
     stuck = np.ones(m, dtype=np.bool_)
@@ -108,11 +111,6 @@ def run_planar_scheme(
     S = np.zeros((nb + 2, nb))  # the stuck pallets' mass and first moments (_s_update)
     A = np.zeros((nb, nb))  # the last factorised Newton matrix, kept across chunks
     fac = np.full(1, -1.0)  # its step length (-1: none)
-    Q = hinges.operator(phi)[:nh]
-    hst = hinges.initial_state()[:nh]
-    # writable: a read-only array (a compiled model's) is another numba specialisation
-    h_k, h_law, h_par, h_th0 = (writable(a[:nh]) for a in
-                                (hinges.k, hinges.law, hinges.par, hinges.theta0))
     HW = np.zeros((4, nh))
     ax = no_axial(nb) if hinges.axial is None else hinges.axial.reduced(phi)
     e_state = np.zeros(5)

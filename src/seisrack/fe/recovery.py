@@ -193,10 +193,12 @@ class RecoveryOperators:
                               above=np.asarray(U2 @ self.above[direction]).reshape(shape))
 
 
-def rack_operators(model: Any) -> tuple[RecoveryOperators, DesignOperators]:
-    """Both operator sets of a compiled rack from one pass over its members."""
+def rack_operators(model: Any, design: bool = True
+                   ) -> tuple[RecoveryOperators, DesignOperators | None]:
+    """Both operator sets of a compiled rack from one pass over its members (the design
+    operators None unless ``design``)."""
     maps = end_force_maps(_mesh(model))
-    return recovery_operators(model, maps), design_operators(model, maps)
+    return recovery_operators(model, maps), design_operators(model, maps) if design else None
 
 
 def recovery_operators(model: Any, maps: EndForceMaps | None = None) -> RecoveryOperators:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg
@@ -70,6 +71,12 @@ class LocalBasis:
     @property
     def bmax(self) -> int:
         return int(self.Md.shape[1])
+
+    @cached_property
+    def phi(self) -> sp.csr_matrix:
+        """V as a sparse (n, size) CSR matrix, made once per basis (the default engine's
+        :class:`~seisrack.dynamics.basis.Basis` has the same attribute, dense)."""
+        return self.matrix().tocsr()
 
     def matrix(self) -> sp.csc_matrix:
         """V as a sparse (n, size) matrix."""

@@ -12,8 +12,8 @@ from collections.abc import Callable
 import numpy as np
 
 from seisrack.dynamics._blas import blas_controller
-from seisrack.dynamics._store import keep_index, refuse_over_budget
-from seisrack.dynamics.kernels import scheme_kernel, writable
+from seisrack.dynamics._store import check_kept_memory, keep_index
+from seisrack.dynamics.kernels import scheme_kernel, writable_all
 from seisrack.dynamics.local.basis import LocalBasis
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory, central_accelerations
 from seisrack.dynamics.local.sliders import LocalSliders
@@ -74,16 +74,14 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     chunk = min(int(chunk_steps or (500 if progress is not None else DEFAULT_CHUNK)), n_steps)
     m = sliders.count
     N = basis.size
+    nq = N if keep_coordinates else 0
+    check_kept_memory(n_steps, save_every, *memory_terms(chunk, nq, m, basis), max_memory,
+                      f"{nq} coordinates and {m} pallets", "Keep fewer samples (save_every=k, "
+                      "or None with on_chunk), or keep_coordinates=False")
     keep_idx = keep_index(n_steps, save_every)
-    n_keep = keep_idx.size
-    need = memory_estimate(n_keep, chunk, N if keep_coordinates else 0, m, basis)
-    refuse_over_budget(need, max_memory,
-                       f"{n_keep} kept samples of {N if keep_coordinates else 0} coordinates "
-                       f"and {m} pallets", "Keep fewer samples (save_every=k, or None with "
-                       "on_chunk), or keep_coordinates=False")
 
     P, ps = support_rows(basis, sliders)
-    Vm = basis.matrix()
+    Vm = basis.phi
     described = basis.describe()
     pats_r = [-(Vm.T @ (M @ r[d])) for d in range(nd)]
     series = [ag[:, d] for d in range(nd)]
@@ -97,10 +95,9 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     gz = g + (av if av is not None else np.zeros(n_t))
     mod, used = _kernel(backend)
 
-    w = writable
-    mats = [w(getattr(basis, k)) for k in ("Md", "Cd", "Kd", "Mo", "Co", "Ko")]
-    sizes, offsets = w(basis.sizes), w(basis.offsets)
-    mass, mus, mud = w(sliders.mass), w(sliders.mu_static), w(sliders.mu_dynamic)
+    *mats, sizes, offsets, mass, mus, mud = writable_all(
+        basis.Md, basis.Cd, basis.Kd, basis.Mo, basis.Co, basis.Ko, basis.sizes, basis.offsets,
+        sliders.mass, sliders.mu_static, sliders.mu_dynamic)
     q, v, dvp = np.zeros(N), np.zeros(N), np.zeros(N)
     stuck = np.ones(m, dtype=np.bool_)
     sv, dirn, uu, lam, beta = (np.zeros((m, 2)) for _ in range(5))
@@ -112,7 +109,6 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
-    nq = N if keep_coordinates else 0
     bufs = (np.empty((chunk + 1, nq)), np.empty((chunk + 1, nq)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m, 2)), np.empty((chunk + 1, m, 2)),
             np.empty((chunk + 1, m), dtype=np.bool_), np.empty((chunk + 1, 5)))
@@ -177,7 +173,14 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
 
 def memory_estimate(n_keep: int, chunk: int, nq: int, m: int, basis: LocalBasis) -> int:
     """Bytes the run's kept histories, chunk buffers and kernel work arrays take."""
+    per_sample, fixed = memory_terms(chunk, nq, m, basis)
+    return n_keep * per_sample + fixed
+
+
+def memory_terms(chunk: int, nq: int, m: int, basis: LocalBasis) -> tuple[int, int]:
+    """(bytes per kept sample, bytes of the chunk buffers and kernel work arrays) of a run
+    keeping ``nq`` coordinates and ``m`` pallets per sample."""
     per_row = 8 * (3 * nq + 6 * m + 5) + m
     work = 8 * (13 * basis.n_slices * basis.bmax**2 + 12 * basis.size + 40 * m
                 + 2 * m * basis.bmax)
-    return n_keep * (per_row + 8 * m) + (chunk + 1) * per_row + work
+    return per_row + 8 * m, (chunk + 1) * per_row + work
