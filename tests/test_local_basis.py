@@ -26,6 +26,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from seisrack.analysis import run_rack
+from seisrack.analysis.prepare import rack_sliders
 from seisrack.dynamics.local import LocalSliders, local_basis, measure_error
 from seisrack.dynamics.local.basis import dense
 from seisrack.dynamics.local.racks import rack_basis, rack_slices
@@ -51,7 +52,7 @@ def _row(tmp_path: Path, bays: int, levels: int = 5):
 
 def test_reduced_matrices_are_the_projection(tmp_path):
     model = _row(tmp_path, 3, 2)
-    b = rack_basis(model, check="none")
+    b = rack_basis(model, rack_sliders(model, "local"), check="none")
     V = b.matrix()
     assert b.n_slices == 7  # four upright lines and three bays
     for name, A in (("K", model.K_sparse), ("M", model.M_sparse), ("C", model.C_sparse)):
@@ -77,7 +78,7 @@ def test_measured_error_falls_with_the_tolerance(tmp_path):
     model = _row(tmp_path, 4, 3)
     errs, sizes = [], []
     for tol in (0.3, 0.1, 0.03):
-        b = rack_basis(model, tol=tol, check="none")
+        b = rack_basis(model, rack_sliders(model, "local"), tol=tol, check="none")
         sl = LocalSliders(model.pallet_dofs, model.pallet_mass, 0.3)
         n = model.n_dof
         loads = np.column_stack([model.M_sparse @ model.r_x, model.M_sparse @ model.r_z])

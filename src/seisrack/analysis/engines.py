@@ -39,17 +39,21 @@ def simulate_rack(model: FrameModel, prepared: PreparedRun, ag: np.ndarray,
     (friction :data:`~seisrack.analysis.prepare.RIGID_MU`, peaks only, the main run's
     method), made when the rack carries pallets. Returns the main run's history."""
     kw = dict(max_memory=max_memory, throw=throw, backend=backend)
+    rigid = companion is not None and model.n_pallets > 0
     if prepared.engine == "local":
-        run, opts = simulate_rack_local, {}
-    else:
-        run, opts = simulate_rack_default, dict(method=method, track_energy=track_energy)
-    hist = run(model, prepared, ag, av, h, on_chunk=on_chunk, progress=progress,
-               save_every=save_every, **opts, **kw)
-    if companion is not None and model.n_pallets:
-        if opts:  # the main run's method, no energy
-            opts = dict(method="exact" if hist.method == "exact" else method, track_energy=False)
-        run(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=companion, save_every=None,
-            **opts, **kw)
+        hist = simulate_rack_local(model, prepared, ag, av, h, on_chunk=on_chunk,
+                                   progress=progress, save_every=save_every, **kw)
+        if rigid:
+            simulate_rack_local(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=companion,
+                                save_every=None, **kw)
+        return hist
+    hist = simulate_rack_default(model, prepared, ag, av, h, on_chunk=on_chunk,
+                                 progress=progress, save_every=save_every, method=method,
+                                 track_energy=track_energy, **kw)
+    if rigid:  # the main run's method, no energy
+        simulate_rack_default(model, prepared, ag, av, h, mu=RIGID_MU, on_chunk=companion,
+                              save_every=None, track_energy=False,
+                              method="exact" if hist.method == "exact" else method, **kw)
     return hist
 
 
@@ -73,9 +77,10 @@ def simulate_rack_default(model: FrameModel, prepared: PreparedRun, ag: np.ndarr
                           throw: bool = True, backend: str = "auto") -> TimeHistory:
     """One run of the default engine (:func:`seisrack.dynamics.simulate`) on ``model``, its
     pallets' friction ``mu`` as in :func:`run_sliders`; arguments as :func:`simulate_rack`."""
+    sliders = run_sliders(prepared, model, mu)
     try:
         return simulate(
-            model.M_sparse, model.C_sparse, model.K_sparse, run_sliders(prepared, model, mu),
+            model.M_sparse, model.C_sparse, model.K_sparse, sliders,
             dt=h, ground_accel=ag, influence=np.column_stack(model.influence),
             vertical_accel=av, vertical_influence=None if av is None else model.r_y, g=model.g,
             basis=prepared.basis, hinges=prepared.hinges, track_energy=track_energy,
@@ -101,6 +106,7 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
     :func:`run_sliders`; arguments as :func:`simulate_rack`."""
     from seisrack.dynamics.local.scheme import run_local_scheme
 
+    sliders = run_sliders(prepared, model, mu)
     line = model.n_dir == 1
     sq = (lambda a: a[..., 0]) if line else (lambda a: a)  # noqa: E731
 
@@ -109,7 +115,7 @@ def simulate_rack_local(model: FrameModel, prepared: PreparedRun, ag: np.ndarray
                        sliding=sq(ch.sliding), sliding_v=sq(ch.velocity)))
 
     hist = run_local_scheme(
-        model.M_sparse, run_sliders(prepared, model, mu), prepared.basis, dt=h, ag=ag,
+        model.M_sparse, sliders, prepared.basis, dt=h, ag=ag,
         r=np.array(model.influence), av=av, rv=None if av is None else model.r_y, g=model.g,
         save_every=save_every, on_chunk=None if on_chunk is None else chunk_cb,
         progress=progress, max_memory=max_memory, throw=throw, backend=backend)

@@ -58,13 +58,15 @@ def check_memory(n_steps: int, save_every: int | None, chunk: int, nb: int, m: i
 
 
 def check_kept_memory(n_steps: int, save_every: int | None, per_sample: float, fixed: float,
-                      max_memory: float | None, what: str, hint: str) -> None:
-    """Refuse (:func:`refuse_over_budget`), before anything is allocated, a run of ``n_steps``
-    keeping every ``save_every``-th sample (:func:`kept_samples`) at ``per_sample`` bytes each,
-    with ``fixed`` bytes of buffers; ``what``: what a sample holds (for the message)."""
+                      max_memory: float | None, what: str, hint: str) -> np.ndarray:
+    """The steps a run of ``n_steps`` keeps (:func:`keep_index`), once a run keeping every
+    ``save_every``-th sample at ``per_sample`` bytes each, with ``fixed`` bytes of buffers, is
+    known to fit (:func:`refuse_over_budget`, before anything is allocated); ``what``: what a
+    sample holds (for the message)."""
     n_keep = kept_samples(n_steps, save_every)
     refuse_over_budget(n_keep * per_sample + fixed, max_memory,
                        f"{n_steps} steps keeping {n_keep} samples of {what}", hint)
+    return keep_index(n_steps, save_every)
 
 
 def refuse_over_budget(need: float, max_memory: float | None, what: str, hint: str) -> None:

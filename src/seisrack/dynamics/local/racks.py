@@ -80,19 +80,19 @@ def rack_level_patterns(model) -> np.ndarray:  # noqa: ANN001
     return np.column_stack(cols) if cols else np.zeros((n, 0))
 
 
-def rack_basis(model, sliders: LocalSliders | None = None, *,  # noqa: ANN001
+def rack_basis(model, sliders: LocalSliders, *,  # noqa: ANN001
                tol: float | None = None, patch: int | None = None, vertical: bool = False,
                check: str = "static"):  # noqa: ANN201
     """The local basis of a compiled rack (slices by upright line, the pallets' friction
     patterns, the ground loads and a uniform load on every level for the far field), with its
     error measured against the full model (``check``: "static", "full" or "none").
     ``sliders``: the rack's pallets as the run's :class:`LocalSliders` (their supports and
-    masses; friction plays no part in the basis), default made here from the model."""
+    masses; friction plays no part in the basis: ``analysis.prepare.rack_sliders(model,
+    "local")``)."""
     from seisrack.dynamics.local.basis import DEFAULT_TOL, local_basis, measure_error
 
     slices, levels = rack_slices(model), rack_level_patterns(model)
-    sl = LocalSliders(np.asarray(model.pallet_dofs), model.pallet_mass, 0.0) if (
-        sliders is None) else sliders
+    sl = sliders
     n = model.K_sparse.shape[0]
     M = model.M_sparse
     extra = sl.attached_mass(n)

@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from seisrack.dynamics._blas import blas_controller
-from seisrack.dynamics._store import check_kept_memory, keep_index
+from seisrack.dynamics._store import check_kept_memory
 from seisrack.dynamics.kernels import scheme_kernel, writable_all
 from seisrack.dynamics.local.basis import LocalBasis
 from seisrack.dynamics.local.result import LocalChunk, LocalHistory, central_accelerations
@@ -75,14 +75,14 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     m = sliders.count
     N = basis.size
     nq = N if keep_coordinates else 0
-    check_kept_memory(n_steps, save_every, *memory_terms(chunk, nq, m, basis), max_memory,
-                      f"{nq} coordinates and {m} pallets", "Keep fewer samples (save_every=k, "
-                      "or None with on_chunk), or keep_coordinates=False")
-    keep_idx = keep_index(n_steps, save_every)
-
-    P, ps = support_rows(basis, sliders)
-    Vm = basis.phi
+    per_sample, fixed = memory_terms(chunk, nq, m, basis)
+    P, ps = support_rows(basis, sliders)  # small: (2m, patch) rows
     described = basis.describe()
+    keep_idx = check_kept_memory(n_steps, save_every, per_sample, fixed, max_memory,
+                                 f"{nq} coordinates and {m} pallets", "Keep fewer samples "
+                                 "(save_every=k, or None with on_chunk), or "
+                                 "keep_coordinates=False")
+    Vm = basis.phi
     pats_r = [-(Vm.T @ (M @ r[d])) for d in range(nd)]
     series = [ag[:, d] for d in range(nd)]
     if rv is not None:
