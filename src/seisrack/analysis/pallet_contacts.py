@@ -103,9 +103,15 @@ class ContactTracker:
                         self.fall_time[p] = tr
                         self.fall_side[p] = sign
         todo = np.flatnonzero(np.isnan(self.impact_time))
-        # a closure u_left - u_right - gap is at most 2 max|u| - gap: most chunks stop here
-        if todo.size and 2.0 * float(np.abs(u[:, :, 0]).max(initial=0.0)) >= float(
-                lay.contact_gap[todo].min()):
+        if todo.size:
+            # a closure u_left - u_right - gap is at most max u_left - min u_right - gap (the
+            # rounding is monotone: no crossing is missed): only those contacts are followed
+            ux = u[:, :, 0]
+            hi = np.append(ux.max(axis=0), 0.0)  # the last column: UPRIGHT, at rest
+            lo = np.append(ux.min(axis=0), 0.0)
+            todo = todo[hi[lay.contact_left[todo]] - lo[lay.contact_right[todo]]
+                        - lay.contact_gap[todo] >= 0.0]
+        if todo.size:
             ux = np.zeros((t.size, u.shape[1] + 1))
             ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
             left, right = lay.contact_left[todo], lay.contact_right[todo]

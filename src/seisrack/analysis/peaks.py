@@ -14,6 +14,7 @@ import functools
 
 import numpy as np
 
+from seisrack.analysis import chunk_pass
 from seisrack.analysis.design_pass import design_pass
 from seisrack.analysis.operators import (  # noqa: F401  (re-exported)
     DIRECTION_SUFFIX,
@@ -23,6 +24,7 @@ from seisrack.analysis.operators import (  # noqa: F401  (re-exported)
     rack_operators,
 )
 from seisrack.dynamics.engine import Chunk
+from seisrack.errors import InputError
 
 
 def level_sum(friction: np.ndarray, pallet_level: np.ndarray, n_level: int) -> np.ndarray:
@@ -63,7 +65,8 @@ class PeakTracker:
     """
 
     def __init__(self, ops: RackOperators, pallet_level: np.ndarray, ag: np.ndarray,
-                 h: float, smooth: bool, keep_accel: bool = False, design: bool = True) -> None:
+                 h: float, smooth: bool, keep_accel: bool = False, design: bool = True,
+                 keep_series: bool = False, backend: str = "auto") -> None:
         self.ops, self.lv = ops, pallet_level
         self.ag, self.h, self.smooth = ag, h, smooth
         nl, m, nd = ops.n_level, pallet_level.shape[0], ops.n_dir
@@ -101,8 +104,87 @@ class PeakTracker:
             ns = d.ops["axial"].shape[1]
             self.n_at_max_n = np.zeros((2, ns))  # rows: N, M at the largest |N|
             self.nm_at_max_m = np.zeros((2, ns))  # rows: N, M at the largest |M|
+        if backend not in ("auto", "numba", "numpy"):
+            raise InputError("backend", backend, '"auto", "numba" or "numpy"')
+        self._fused = backend == "numba" or (backend == "auto" and chunk_pass.HAVE_NUMBA)
+        self._backend = "numba" if self._fused else "numpy"
+        self._series: dict[str, np.ndarray] | None = None
+        if self._fused:
+            self._fused_setup(ag.shape[0], keep_series)
+
+    def _fused_setup(self, n_t: int, keep_series: bool) -> None:
+        """Operators side by side and the full-run arrays of the compiled pass
+        (:mod:`seisrack.analysis.chunk_pass`)."""
+        o = self.ops
+        nl, nd, nu = o.n_level, o.n_dir, o.n_upright
+        lev = self._level
+        # transposed, (K, r): each quantity's operator is a contiguous row
+        self._wq = np.ascontiguousarray(np.concatenate(
+            [lev, o.shear, *o.base_moment, *o.below, *o.above], axis=1).T, dtype=float)
+        self._wd = np.ascontiguousarray(np.concatenate([lev, o.shear], axis=1).T, dtype=float)
+        self._wa = np.ascontiguousarray(lev.T, dtype=float)
+        self._vp = np.zeros(nl * nd)  # level velocities of the step before the chunk
+        self._filled = 0
+        self._acc_full = None if self._acc is None else np.empty((n_t, nl, nd))
+        self._lv64 = np.ascontiguousarray(self.lv, dtype=np.int64)
+        self._fsum = np.zeros((nl, nd))
+        if keep_series:
+            self._series = {
+                "disp": np.empty((n_t, nl, nd)), "acc_raw": np.empty((n_t, nl, nd)),
+                "shear": np.empty((n_t, nd)), "base": np.empty((n_t, nu, nd)),
+                "conn": np.empty((n_t, nu, nl, nd))}
+
+    def _fused_call(self, c: Chunk) -> None:
+        o = self.ops
+        nl, nd = o.n_level, o.n_dir
+        k = c.t.shape[0]
+        k0 = int(round(c.t[0] / self.h))
+        ag = np.ascontiguousarray(self.ag[k0:k0 + k], dtype=float)
+        if self._acc_full is not None:
+            a_out, row0 = self._acc_full, k0
+        else:
+            a_out, row0 = np.empty((k, nl, nd)), 0
+        vbuf = np.empty((k, nl * nd) if self.smooth else (0, 0))
+        sr = self._series
+        series = sr is not None
+        none3, none4 = np.empty((0, 0, 0)), np.empty((0, 0, 0, 0))
+        kept = chunk_pass.level_pass(
+            np.ascontiguousarray(c.q), np.ascontiguousarray(c.qd), np.ascontiguousarray(c.qdd),
+            ag, self._wq, self._wd, self._wa, nl, o.n_upright, float(o.a1), bool(self.smooth),
+            float(self.h), self._vp, self._v_prev is not None, self.disp, self.acc,
+            self.acc_mag, self.shear, self.m_base, self.m_conn, a_out, row0, vbuf, series,
+            sr["disp"] if series else none3, sr["acc_raw"] if series else none3,
+            sr["shear"] if series else np.empty((0, 0)), sr["base"] if series else none3,
+            sr["conn"] if series else none4)
+        self._v_prev = self._vp if kept else None
+        self._filled = k0 + k
+        if hasattr(self, "_dop"):
+            self._design(c.q)
+        if self.lv.shape[0]:
+            planar = c.friction.ndim == 3
+            chunk_pass.pallet_pass(
+                np.ascontiguousarray(with_direction(c.friction, planar), dtype=float),
+                np.ascontiguousarray(with_direction(c.sliding, planar), dtype=float),
+                self._lv64, self.force, self.total_force, self.slide_max, self.slide_min,
+                self.slide_mag, self._fsum)
+
+    def series(self) -> dict[str, np.ndarray] | None:
+        """The full-rate histories the compiled pass kept (``keep_series``): level
+        displacement ``disp`` and raw absolute acceleration ``acc_raw`` (n_t, n_level, n_dir),
+        base shear ``shear`` (n_t, n_dir), upright base moments ``base`` (n_t, n_upright,
+        n_dir), connection moments ``conn`` (n_t, n_upright, n_level, n_dir), and the
+        reported absolute level acceleration ``acc`` (:meth:`level_acceleration`); None when
+        not kept."""
+        if self._series is None or self._acc_full is None:
+            return None
+        out = {name: a[:self._filled] for name, a in self._series.items()}
+        out["acc"] = self._acc_full[:self._filled]
+        return out
 
     def __call__(self, c: Chunk) -> None:
+        if self._fused:
+            self._fused_call(c)
+            return
         o = self.ops
         nl, nd = o.n_level, o.n_dir
         k0 = int(round(c.t[0] / self.h))
@@ -147,11 +229,14 @@ class PeakTracker:
 
     def _design(self, q: np.ndarray) -> None:
         design_pass(q, self._dop, self._dmax_all, self._dmin_all, *self._d_at, *self._static,
-                    self.n_at_max_n, self.nm_at_max_m)
+                    self.n_at_max_n, self.nm_at_max_m, backend=self._backend)
 
     def level_acceleration(self) -> np.ndarray | None:
         """(n_step + 1, n_level, n_dir) [m/s²] full-rate absolute level accelerations, or None
         when they were not kept (``keep_accel=False`` or more than :data:`FULL_RATE_ACCEL_MAX`)."""
+        if self._fused:
+            return None if self._acc_full is None or not self._filled else (
+                self._acc_full[:self._filled])
         if self._acc is None or self._last_acc is None:
             return None
         return np.concatenate([*self._acc, self._last_acc[None]], axis=0)

@@ -123,7 +123,8 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             k = stop - start + 1
             ser = np.ascontiguousarray(series[rows])
             pext = np.ascontiguousarray(ser @ pat)
-            N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
+            N = np.multiply.outer(gz[rows], mass)  # np.outer, clipped in place: one array
+            np.clip(N, 0.0, None, out=N)
             ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
             left = max(int(max_events) - n_ev, 0)
             outs = buf.views(k)
