@@ -62,6 +62,10 @@ class PeakTracker:
     gravity + seismic (M in the down-aisle plane).
 
     ag: (n_t, n_dir) [m/s²] the ground acceleration of each direction at every step.
+    backend: "auto" (the compiled pass of :mod:`seisrack.analysis.chunk_pass` when numba is
+    installed), "numba" or "numpy" (the array code below, its twin). keep_series (compiled
+    pass only): also keep the full-rate histories the response reports (:meth:`series`), for
+    a run that keeps every step.
     """
 
     def __init__(self, ops: RackOperators, pallet_level: np.ndarray, ag: np.ndarray,
@@ -104,8 +108,10 @@ class PeakTracker:
             ns = d.ops["axial"].shape[1]
             self.n_at_max_n = np.zeros((2, ns))  # rows: N, M at the largest |N|
             self.nm_at_max_m = np.zeros((2, ns))  # rows: N, M at the largest |M|
-        if backend not in ("auto", "numba", "numpy"):
-            raise InputError("backend", backend, '"auto", "numba" or "numpy"')
+        if backend not in ("auto", "numba", "numpy") or (
+                backend == "numba" and not chunk_pass.HAVE_NUMBA):
+            raise InputError("backend", backend, '"auto", "numba" or "numpy"'
+                             + ("" if chunk_pass.HAVE_NUMBA else " (numba is not installed)"))
         self._fused = backend == "numba" or (backend == "auto" and chunk_pass.HAVE_NUMBA)
         self._backend = "numba" if self._fused else "numpy"
         self._series: dict[str, np.ndarray] | None = None
