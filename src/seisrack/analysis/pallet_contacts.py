@@ -103,9 +103,22 @@ class ContactTracker:
                         self.fall_time[p] = tr
                         self.fall_side[p] = sign
         todo = np.flatnonzero(np.isnan(self.impact_time))
-        # a closure u_left - u_right - gap is at most 2 max|u| - gap: most chunks stop here
-        if todo.size and 2.0 * float(np.abs(u[:, :, 0]).max(initial=0.0)) >= float(
-                lay.contact_gap[todo].min()):
+        if todo.size:
+            # a closure u_left - u_right - gap is at most max u_left - min u_right - gap (the
+            # rounding is monotone: no crossing is missed): only those contacts are followed
+            # (first over every pallet at once; per column, not np.max(axis=0), which is
+            # ~7x slower on an (n_t, few) array)
+            ux = u[:, :, 0]
+            if max(float(ux.max()), 0.0) - min(float(ux.min()), 0.0) < float(
+                    lay.contact_gap[todo].min()):
+                todo = todo[:0]
+            else:
+                cols = range(ux.shape[1])
+                hi = np.array([ux[:, j].max() for j in cols] + [0.0])  # last: UPRIGHT, at rest
+                lo = np.array([ux[:, j].min() for j in cols] + [0.0])
+                todo = todo[hi[lay.contact_left[todo]] - lo[lay.contact_right[todo]]
+                            - lay.contact_gap[todo] >= 0.0]
+        if todo.size:
             ux = np.zeros((t.size, u.shape[1] + 1))
             ux[:, :-1] = u[:, :, 0]  # column -1 (UPRIGHT) stays 0
             left, right = lay.contact_left[todo], lay.contact_right[todo]

@@ -14,6 +14,8 @@ import functools
 
 import numpy as np
 
+from seisrack.analysis import chunk_pass
+from seisrack.analysis.design_pass import design_pass
 from seisrack.analysis.operators import (  # noqa: F401  (re-exported)
     DIRECTION_SUFFIX,
     DesignOps,
@@ -22,6 +24,7 @@ from seisrack.analysis.operators import (  # noqa: F401  (re-exported)
     rack_operators,
 )
 from seisrack.dynamics.engine import Chunk
+from seisrack.errors import InputError
 
 
 def level_sum(friction: np.ndarray, pallet_level: np.ndarray, n_level: int) -> np.ndarray:
@@ -59,10 +62,15 @@ class PeakTracker:
     gravity + seismic (M in the down-aisle plane).
 
     ag: (n_t, n_dir) [m/s²] the ground acceleration of each direction at every step.
+    backend: "auto" (the compiled pass of :mod:`seisrack.analysis.chunk_pass` when numba is
+    installed), "numba" or "numpy" (the array code below, its twin). keep_series (compiled
+    pass only): also keep the full-rate histories the response reports (:meth:`series`), for
+    a run that keeps every step.
     """
 
     def __init__(self, ops: RackOperators, pallet_level: np.ndarray, ag: np.ndarray,
-                 h: float, smooth: bool, keep_accel: bool = False, design: bool = True) -> None:
+                 h: float, smooth: bool, keep_accel: bool = False, design: bool = True,
+                 keep_series: bool = False, backend: str = "auto") -> None:
         self.ops, self.lv = ops, pallet_level
         self.ag, self.h, self.smooth = ag, h, smooth
         nl, m, nd = ops.n_level, pallet_level.shape[0], ops.n_dir
@@ -86,18 +94,103 @@ class PeakTracker:
         self.dmax: dict[str, np.ndarray] = {}
         self.dmin: dict[str, np.ndarray] = {}
         if d is not None:
-            # one (r, Σk) product per chunk instead of one per quantity
+            # one (r, Σk) operator for every quantity, passed over once per chunk
             mats = [d.ops[name] for name in d.names]
-            # held transposed, (Σk, r): the product with qᵀ is (Σk, n_t), C-ordered
-            self._dop = np.ascontiguousarray(np.concatenate(mats, axis=1).T)
+            self._dop = np.ascontiguousarray(np.concatenate(mats, axis=1), dtype=float)
             self._dsplit = np.cumsum([m_.shape[1] for m_ in mats])[:-1]
-            self._dmax_all = np.full(self._dop.shape[0], -np.inf)
-            self._dmin_all = np.full(self._dop.shape[0], np.inf)
+            first = dict(zip(d.names, np.concatenate([[0], self._dsplit]).tolist(), strict=True))
+            self._d_at = (first["axial"], first["section_moment"])
+            # writable copies: numba compiles another specialisation for read-only arrays
+            self._static = (np.array(d.static["axial"], dtype=float),
+                            np.array(d.static["section_moment"], dtype=float))
+            self._dmax_all = np.full(self._dop.shape[1], -np.inf)
+            self._dmin_all = np.full(self._dop.shape[1], np.inf)
             ns = d.ops["axial"].shape[1]
             self.n_at_max_n = np.zeros((2, ns))  # rows: N, M at the largest |N|
             self.nm_at_max_m = np.zeros((2, ns))  # rows: N, M at the largest |M|
+        if backend not in ("auto", "numba", "numpy") or (
+                backend == "numba" and not chunk_pass.HAVE_NUMBA):
+            raise InputError("backend", backend, '"auto", "numba" or "numpy"'
+                             + ("" if chunk_pass.HAVE_NUMBA else " (numba is not installed)"))
+        self._fused = backend == "numba" or (backend == "auto" and chunk_pass.HAVE_NUMBA)
+        self._backend = "numba" if self._fused else "numpy"
+        self._series: dict[str, np.ndarray] | None = None
+        if self._fused:
+            self._fused_setup(ag.shape[0], keep_series)
+
+    def _fused_setup(self, n_t: int, keep_series: bool) -> None:
+        """Operators side by side and the full-run arrays of the compiled pass
+        (:mod:`seisrack.analysis.chunk_pass`)."""
+        o = self.ops
+        nl, nd, nu = o.n_level, o.n_dir, o.n_upright
+        lev = self._level
+        # transposed, (K, r): each quantity's operator is a contiguous row
+        self._wq = np.ascontiguousarray(np.concatenate(
+            [lev, o.shear, *o.base_moment, *o.below, *o.above], axis=1).T, dtype=float)
+        self._wd = np.ascontiguousarray(np.concatenate([lev, o.shear], axis=1).T, dtype=float)
+        self._wa = np.ascontiguousarray(lev.T, dtype=float)
+        self._vp = np.zeros(nl * nd)  # level velocities of the step before the chunk
+        self._filled = 0
+        self._acc_full = None if self._acc is None else np.empty((n_t, nl, nd))
+        self._lv64 = np.ascontiguousarray(self.lv, dtype=np.int64)
+        self._fsum = np.zeros((nl, nd))
+        if keep_series:
+            self._series = {
+                "disp": np.empty((n_t, nl, nd)), "acc_raw": np.empty((n_t, nl, nd)),
+                "shear": np.empty((n_t, nd)), "base": np.empty((n_t, nu, nd)),
+                "conn": np.empty((n_t, nu, nl, nd))}
+
+    def _fused_call(self, c: Chunk) -> None:
+        o = self.ops
+        nl, nd = o.n_level, o.n_dir
+        k = c.t.shape[0]
+        k0 = int(round(c.t[0] / self.h))
+        ag = np.ascontiguousarray(self.ag[k0:k0 + k], dtype=float)
+        if self._acc_full is not None:
+            a_out, row0 = self._acc_full, k0
+        else:
+            a_out, row0 = np.empty((k, nl, nd)), 0
+        vbuf = np.empty((k, nl * nd) if self.smooth else (0, 0))
+        sr = self._series
+        series = sr is not None
+        none3, none4 = np.empty((0, 0, 0)), np.empty((0, 0, 0, 0))
+        kept = chunk_pass.level_pass(
+            np.ascontiguousarray(c.q), np.ascontiguousarray(c.qd), np.ascontiguousarray(c.qdd),
+            ag, self._wq, self._wd, self._wa, nl, o.n_upright, float(o.a1), bool(self.smooth),
+            float(self.h), self._vp, self._v_prev is not None, self.disp, self.acc,
+            self.acc_mag, self.shear, self.m_base, self.m_conn, a_out, row0, vbuf, series,
+            sr["disp"] if series else none3, sr["acc_raw"] if series else none3,
+            sr["shear"] if series else np.empty((0, 0)), sr["base"] if series else none3,
+            sr["conn"] if series else none4)
+        self._v_prev = self._vp if kept else None
+        self._filled = k0 + k
+        if hasattr(self, "_dop"):
+            self._design(c.q)
+        if self.lv.shape[0]:
+            planar = c.friction.ndim == 3
+            chunk_pass.pallet_pass(
+                np.ascontiguousarray(with_direction(c.friction, planar), dtype=float),
+                np.ascontiguousarray(with_direction(c.sliding, planar), dtype=float),
+                self._lv64, self.force, self.total_force, self.slide_max, self.slide_min,
+                self.slide_mag, self._fsum)
+
+    def series(self) -> dict[str, np.ndarray] | None:
+        """The full-rate histories the compiled pass kept (``keep_series``): level
+        displacement ``disp`` and raw absolute acceleration ``acc_raw`` (n_t, n_level, n_dir),
+        base shear ``shear`` (n_t, n_dir), upright base moments ``base`` (n_t, n_upright,
+        n_dir), connection moments ``conn`` (n_t, n_upright, n_level, n_dir), and the
+        reported absolute level acceleration ``acc`` (:meth:`level_acceleration`); None when
+        not kept."""
+        if self._series is None or self._acc_full is None:
+            return None
+        out = {name: a[:self._filled] for name, a in self._series.items()}
+        out["acc"] = self._acc_full[:self._filled]
+        return out
 
     def __call__(self, c: Chunk) -> None:
+        if self._fused:
+            self._fused_call(c)
+            return
         o = self.ops
         nl, nd = o.n_level, o.n_dir
         k0 = int(round(c.t[0] / self.h))
@@ -141,27 +234,15 @@ class PeakTracker:
             np.maximum(self.slide_mag, mag, out=self.slide_mag)
 
     def _design(self, q: np.ndarray) -> None:
-        d = self.ops.design
-        # (k, n_t): every reduction below runs along contiguous rows (several times faster
-        # than along axis 0 of (n_t, k); the values and the first-maximum ties are the same),
-        # formed as such by the product instead of a transposed copy
-        xt = self._dop @ q.T
-        np.maximum(self._dmax_all, xt.max(axis=1, initial=-np.inf), out=self._dmax_all)
-        np.minimum(self._dmin_all, xt.min(axis=1, initial=np.inf), out=self._dmin_all)
-        vals = dict(zip(d.names, np.split(xt, self._dsplit, axis=0), strict=True))
-        n = vals["axial"] + d.static["axial"][:, None]
-        m = vals["section_moment"] + d.static["section_moment"][:, None]
-        if n.shape[0] and n.shape[1]:
-            rows = np.arange(n.shape[0])
-            for rows_at, x in ((self.n_at_max_n, n), (self.nm_at_max_m, m)):
-                k = np.argmax(np.abs(x), axis=1)
-                better = np.abs(x[rows, k]) > np.abs(rows_at[0 if x is n else 1])
-                rows_at[0, better] = n[rows, k][better]
-                rows_at[1, better] = m[rows, k][better]
+        design_pass(q, self._dop, self._dmax_all, self._dmin_all, *self._d_at, *self._static,
+                    self.n_at_max_n, self.nm_at_max_m, backend=self._backend)
 
     def level_acceleration(self) -> np.ndarray | None:
         """(n_step + 1, n_level, n_dir) [m/s²] full-rate absolute level accelerations, or None
         when they were not kept (``keep_accel=False`` or more than :data:`FULL_RATE_ACCEL_MAX`)."""
+        if self._fused:
+            return None if self._acc_full is None or not self._filled else (
+                self._acc_full[:self._filled])
         if self._acc is None or self._last_acc is None:
             return None
         return np.concatenate([*self._acc, self._last_acc[None]], axis=0)
@@ -292,23 +373,36 @@ def lowpass(a: np.ndarray, h: float, fc: float, order: int = ACCEL_FILTER_ORDER)
     """Zero-phase Butterworth low-pass of ``a: (n_t, ...)`` sampled every ``h`` [s] at ``fc``
     [Hz], along the first axis.
 
-    ``scipy.signal.sosfiltfilt`` (forward and backward: no phase shift, so peaks stay at their
-    time; the magnitude response is the square of the order-``order`` filter's, -6 dB at fc).
-    A cut-off at or above the Nyquist frequency returns ``a`` unchanged.
+    What ``scipy.signal.sosfiltfilt`` computes (forward and backward: no phase shift, so peaks
+    stay at their time; the magnitude response is the square of the order-``order`` filter's,
+    -6 dB at fc), with its odd extension of ``3 (2 n_sections + 1)`` samples at each end and
+    its initial states, written out here so that the states (``sosfilt_zi``, about 0.7 ms)
+    are computed once per filter rather than on every call. A cut-off at or above the Nyquist
+    frequency returns ``a`` unchanged.
     """
-    from scipy.signal import sosfiltfilt
+    from scipy.signal import sosfilt
 
     a = np.asarray(a, dtype=float)
     if fc >= 0.5 / h or a.shape[0] < 2:
         return a.copy()
-    sos = _butter_sos(int(order), float(fc), float(h)).copy()  # scipy wants it writable
-    pad = min(3 * (2 * sos.shape[0] + 1), a.shape[0] - 1)
-    return sosfiltfilt(sos, a, axis=0, padlen=pad)
+    sos, zi = _butter_sos(int(order), float(fc), float(h))
+    sos = sos.copy()  # scipy wants it writable
+    n = min(3 * (2 * sos.shape[0] + 1), a.shape[0] - 1)
+    # odd extension: a "180 degree rotation" of the signal about each end sample
+    ext = np.concatenate((2 * a[:1] - a[n:0:-1], a, 2 * a[-1:] - a[-2:-(n + 2):-1]), axis=0)
+    zi = zi.reshape(zi.shape + (1,) * (a.ndim - 1))  # (n_sections, 2, 1, ...)
+    y, _ = sosfilt(sos, ext, axis=0, zi=zi * ext[:1])
+    y, _ = sosfilt(sos, y[::-1], axis=0, zi=zi * y[-1:])
+    return y[::-1][n:-n]
 
 
 @functools.lru_cache(maxsize=32)
-def _butter_sos(order: int, fc: float, h: float) -> np.ndarray:
-    """Butterworth second-order sections (designed once per (order, fc, h): ~1 ms each)."""
-    from scipy.signal import butter
+def _butter_sos(order: int, fc: float, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Butterworth second-order sections and their steady-state initial conditions for a unit
+    step (``sosfilt_zi``), designed once per (order, fc, h): ~1 ms. Read-only (shared)."""
+    from scipy.signal import butter, sosfilt_zi
 
-    return butter(order, fc, btype="low", fs=1.0 / h, output="sos")
+    sos = butter(order, fc, btype="low", fs=1.0 / h, output="sos")
+    zi = sosfilt_zi(sos)
+    sos.flags.writeable = zi.flags.writeable = False
+    return sos, zi

@@ -162,7 +162,7 @@ def run_rack(
     hinges = prepared.hinges if prepared.hinges is not None and prepared.hinges.nonlinear \
         else None
     tracker = PeakTracker(ops, model.pallet_level, ag, h, smooth=newmark, keep_accel=True,
-                          design=True)
+                          design=True, keep_series=save_every == 1)
     rig = PeakTracker(ops, model.pallet_level, ag, h, smooth=False, design=False) if (
         rigid_companion and model.n_pallets) else None
     contacts = ContactTracker(model.layout, model.n_pallets)
@@ -189,7 +189,7 @@ def run_rack(
     force = level_sum(with_direction(hist.friction, hist.planar), model.pallet_level,
                       ops.n_level)
     resp = _response(model, mot, hist, ag, av, h, rigid_peak, ops, peaks, force,
-                     (tuple(contacts.impacts()), tuple(contacts.falls())))
+                     (tuple(contacts.impacts()), tuple(contacts.falls())), tracker.series())
     idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
     squeeze = (lambda a: a[..., 0]) if model.n_dir == 1 else (lambda a: a)  # noqa: E731
     return replace(resp, acceleration_filter_hz=float(accel_filter_hz),
@@ -216,12 +216,12 @@ def smoothed_acceleration(v: np.ndarray, a: np.ndarray, h: float) -> np.ndarray:
     return out
 
 
-def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.ndarray,
-              av: np.ndarray | None, h: float, rigid_peak: np.ndarray | None, ops,  # noqa: ANN001
-              peaks: dict, force: np.ndarray, impacts_falls: tuple) -> RackResponse:
-    idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
-    nd = model.n_dir
-    agk = ag[idx]  # (n_t, n_dir)
+def _histories(hist: TimeHistory, ops, agk: np.ndarray, h: float,  # noqa: ANN001
+               contiguous: bool) -> tuple[np.ndarray, ...]:
+    """Level displacement, accelerations (reported, raw), base shear, upright base and
+    connection moments at the kept samples, (n_t, ..., n_dir) each, from the basis
+    coordinates."""
+    nd = agk.shape[1]
 
     def per_dir(ops_d: tuple, x: np.ndarray) -> np.ndarray:
         return np.stack([x @ o for o in ops_d], axis=-1)
@@ -229,7 +229,6 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
     disp = per_dir(ops.level, hist.q)
     vel = per_dir(ops.level, hist.qd)
     acc_raw = per_dir(ops.level, hist.qdd) + agk[:, None, :]
-    contiguous = idx.shape[0] == ag.shape[0]
     if hist.method == "newmark" and contiguous:
         acc = smoothed_acceleration(vel, acc_raw - agk[:, None, :], h) + agk[:, None, :]
     else:  # exact propagators leave no period-2h residue; decimated samples are not smoothed
@@ -237,12 +236,33 @@ def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.nd
     # Support reactions include the stiffness-proportional damping forces (C = a0 M + a1 K):
     # the member forces are K (u + a1 v); the a0 M v part acts on the masses, not the supports.
     base_shear = hist.q @ ops.shear + ops.a1 * (hist.qd @ ops.shear)
-    n_t = idx.shape[0]
-    shape = (n_t, ops.n_upright, ops.n_level)
+    shape = (hist.q.shape[0], ops.n_upright, ops.n_level)
     mom_base = per_dir(ops.base_moment, hist.q)
     conn = np.stack([connection_moment((hist.q @ ops.below[d]).reshape(shape),
                                        (hist.q @ ops.above[d]).reshape(shape))
                      for d in range(nd)], axis=-1)
+    return disp, acc, acc_raw, base_shear, mom_base, conn
+
+
+def _response(model: FrameModel, mot: GroundMotion, hist: TimeHistory, ag: np.ndarray,
+              av: np.ndarray | None, h: float, rigid_peak: np.ndarray | None, ops,  # noqa: ANN001
+              peaks: dict, force: np.ndarray, impacts_falls: tuple,
+              series: dict | None = None) -> RackResponse:
+    """The response of the run ``hist``. ``series``: the tracker's full-rate histories
+    (:meth:`~seisrack.analysis.peaks.PeakTracker.series`), taken as they are when every step
+    was kept instead of being formed again from the basis coordinates."""
+    idx = hist.sample_index if hist.sample_index is not None else np.arange(hist.t.shape[0])
+    nd = model.n_dir
+    agk = ag[idx]  # (n_t, n_dir)
+    contiguous = idx.shape[0] == ag.shape[0]
+    if contiguous and series is not None and series["disp"].shape[0] == idx.shape[0]:
+        disp, acc_raw, acc = series["disp"], series["acc_raw"], series["acc"]
+        if hist.method != "newmark":  # see below: the same values (a + ag), kept once
+            acc = acc_raw
+        base_shear, mom_base, conn = series["shear"], series["base"], series["conn"]
+    else:
+        disp, acc, acc_raw, base_shear, mom_base, conn = _histories(hist, ops, agk, h,
+                                                                    contiguous)
     sq = (lambda a: a[..., 0]) if nd == 1 else (lambda a: a)  # noqa: E731
     lay = model.layout
     impacts, falls = impacts_falls

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 
 from threadpoolctl import ThreadpoolController
 
 _CONTROLLER: list[ThreadpoolController] = []
+#: how deep this thread is inside one_blas_thread: only the outermost sets and restores
+_DEPTH = threading.local()
 
 
 def blas_controller() -> ThreadpoolController:
@@ -18,11 +22,26 @@ def blas_controller() -> ThreadpoolController:
     return _CONTROLLER[0]
 
 
-def one_blas_thread():  # noqa: ANN201
+@contextlib.contextmanager
+def one_blas_thread() -> Iterator[None]:
     """A context limiting BLAS to one thread: the kernels' algebra is small (r x r), and a
     threaded BLAS only adds spinning threads, which made runs 5-10x slower on a loaded 2-core
-    machine (measured on the warehouse rack)."""
-    return blas_controller().limit(limits=1, user_api="blas")
+    machine (measured on the warehouse rack). Nested uses (``run_rack`` around the engine's
+    chunk loop) set the limit once: each setting and restoring costs ~0.1 ms."""
+    depth = getattr(_DEPTH, "n", 0)
+    if depth:
+        _DEPTH.n = depth + 1
+        try:
+            yield
+        finally:
+            _DEPTH.n = depth
+        return
+    with blas_controller().limit(limits=1, user_api="blas"):
+        _DEPTH.n = 1
+        try:
+            yield
+        finally:
+            _DEPTH.n = 0
 
 
 def single_blas_thread(func: Callable) -> Callable:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +44,54 @@ def check_symmetric(name: str, a) -> None:  # noqa: ANN001
         ok = np.allclose(a, a.T, rtol=1e-10, atol=1e-12 * scale)
     if not ok:
         raise InputError(name, "non-symmetric matrix", "a symmetric matrix")
+
+
+#: locked matrices already checked: id -> (weak reference to the matrix given, the checked
+#: matrix, checked for symmetry too); an entry goes with its matrix
+_CHECKED: dict[int, tuple[weakref.ref, object, bool]] = {}
+
+
+def _locked(mat: object) -> bool:
+    """A matrix locked read-only: an ndarray, or a sparse matrix whose data, indices and index
+    pointers all are (a compiled model's, locked by
+    :func:`seisrack.model.frame_model.read_only`); its entries are taken as unchanging."""
+    if sp.issparse(mat):
+        parts = [getattr(mat, p, None) for p in ("data", "indices", "indptr")]
+        return all(isinstance(p, np.ndarray) and not p.flags.writeable for p in parts)
+    return isinstance(mat, np.ndarray) and not mat.flags.writeable
+
+
+def checked_square(name: str, mat: object, n: int | None):  # noqa: ANN201
+    """:func:`square` of ``mat``, once per locked matrix: a prepared rack hands the engine its
+    compiled model's read-only M, C, K on every run (checking them again cost ~0.4 ms of the
+    paper rack's run, issue 21)."""
+    hit = _CHECKED.get(id(mat))
+    if hit is not None and hit[0]() is mat:
+        a = hit[1]
+        if n is not None and a.shape[0] != n:
+            raise InputError(name, f"shape {a.shape}", f"shape ({n}, {n}) like M")
+        return a
+    a = square(name, mat, n)
+    if _locked(mat):
+        key = id(mat)
+        try:
+            ref = weakref.ref(mat, lambda _, k=key: _CHECKED.pop(k, None))
+        except TypeError:  # pragma: no cover - a type without weak references: not kept
+            return a
+        _CHECKED[key] = (ref, a, False)
+    return a
+
+
+def checked_symmetric(name: str, mat: object, a: object) -> None:
+    """:func:`check_symmetric` of ``a = checked_square(name, mat, ...)``, once per locked
+    matrix."""
+    hit = _CHECKED.get(id(mat))
+    if hit is not None and hit[0]() is mat and hit[1] is a:
+        if not hit[2]:
+            check_symmetric(name, a)
+            _CHECKED[id(mat)] = (hit[0], a, True)
+        return
+    check_symmetric(name, a)
 
 
 def series(name: str, val: object, shape: tuple[int, ...]) -> np.ndarray:
@@ -108,12 +157,13 @@ def run_inputs(M, C, K, sliders, *, dt, n_steps, ground_accel, influence, force,
                hinges, progress) -> RunInputs:
     """Every argument of :func:`seisrack.dynamics.simulate` checked, in one place (see there
     for their meaning); bad input raises :class:`InputError` naming the argument."""
-    M = square("M", M, None)
+    m_in, k_in = M, K
+    M = checked_square("M", M, None)
     n = M.shape[0]
-    C = square("C", C, n)
-    K = square("K", K, n)
-    check_symmetric("M", M)
-    check_symmetric("K", K)
+    C = checked_square("C", C, n)
+    K = checked_square("K", K, n)
+    checked_symmetric("M", m_in, M)
+    checked_symmetric("K", k_in, K)
     planar = isinstance(sliders, PlanarSliders)
     if not (planar or isinstance(sliders, Sliders)):
         raise InputError("sliders", type(sliders).__name__,

@@ -115,6 +115,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
                                  4, 64))
     qs, qds = q0, qd0
     start = 0
+    chunk_seen = None  # the last Chunk handed to on_chunk
     with one_blas_thread():
         while start < n_steps:
             stop = min(start + chunk, n_steps)
@@ -122,7 +123,8 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             k = stop - start + 1
             ser = np.ascontiguousarray(series[rows])
             pext = np.ascontiguousarray(ser @ pat)
-            N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
+            N = np.multiply.outer(gz[rows], mass)  # np.outer, clipped in place: one array
+            np.clip(N, 0.0, None, out=N)
             ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
             left = max(int(max_events) - n_ev, 0)
             outs = buf.views(k)
@@ -147,8 +149,10 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             status = int(st)
             t_chunk = np.arange(start, stop + 1) * dt
             if on_chunk is not None:
-                on_chunk(Chunk(t_chunk, outs[0], outs[1], outs[2], outs[5], outs[6],
-                               hinge_moment=outs[8], slider_u=outs[3], slider_v=outs[4], P=P))
+                chunk_seen = Chunk(t_chunk, outs[0], outs[1], outs[2], outs[5], outs[6],
+                                   hinge_moment=outs[8], slider_u=outs[3], slider_v=outs[4],
+                                   P=P)
+                on_chunk(chunk_seen)
             keep.take(start, stop, n_steps, save_every, outs, N)
             qs, qds = outs[0][k - 1].copy(), outs[1][k - 1].copy()
             if status != 0:
@@ -160,6 +164,10 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
     status_text = run_status(status, _STATUS, "stick-slip integration", throw, _LOG)
     events = recorded_events(ev_time, ev_slider, ev_kind, min(int(n_ev), max_events))
     kq, kqd, kqdd, kw, kwd, klam, kst, ken, khm, kN, kidx = keep.result()
+    if chunk_seen is not None and _same(kq, chunk_seen.q) and _same(kw, chunk_seen.slider_u):
+        sliding = chunk_seen.sliding  # the one chunk kept whole: the same product, once
+    else:
+        sliding = kw - kq @ P.T
     energy = {}
     if track_energy:
         names = ("input", "kinetic", "strain", "damping", "friction")
@@ -176,7 +184,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
         phi=phi,
         slider_u=kw,
         slider_v=kwd,
-        sliding=kw - kq @ P.T,
+        sliding=sliding,
         friction=klam,
         normal=kN,
         stuck=kst,
@@ -194,3 +202,9 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
         hinge_operator=Q,
         hinge_rotation0=h_th0,
     )
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    """``a`` and ``b`` view the very same memory, element for element."""
+    return (a.shape == b.shape and a.strides == b.strides and a.dtype == b.dtype
+            and a.__array_interface__["data"][0] == b.__array_interface__["data"][0])

@@ -45,8 +45,10 @@ def recorded_events(time: np.ndarray, slider: np.ndarray, kind: np.ndarray, n: i
                     *, by_time: bool = False) -> list[Event]:
     """The first ``n`` events of a kernel's buffers (``by_time``: sorted by time, stably, for a
     kernel that records them out of order)."""
-    idx = np.argsort(time[:n], kind="stable") if by_time else range(n)
-    return [Event(float(time[i]), int(slider[i]), EVENT_KINDS[int(kind[i])]) for i in idx]
+    idx = np.argsort(time[:n], kind="stable") if by_time else slice(0, n)
+    # whole columns to Python numbers at once (indexing element by element cost ~1 µs each)
+    return [Event(t, s, EVENT_KINDS[k]) for t, s, k in zip(
+        time[idx].tolist(), slider[idx].tolist(), kind[idx].tolist(), strict=True)]
 
 
 @dataclass(frozen=True)
