@@ -95,19 +95,24 @@ def _to_modal(psitm, q, qd, eta, etad):
 
 
 @_JIT
-def _step_output(k, w2, cd, P, pext, x, xd, q, qd, qdd, w, wd, lam, stuck, mass,
+def _step_output(k, w2, cd, P, series, pat, x, xd, q, qd, qdd, w, wd, lam, stuck, mass,
                  track_energy, E_in, E_damp, E_fric, out_q, out_qd, out_qdd, out_w, out_wd,
                  out_lam, out_stuck, out_energy):
     """End of step ``k``: q = Ψ η and q̇ = Ψ η̇ (``x``, ``xd``, from the last sub-step),
-    q̈ from equilibrium and the output row (as ``_write_output``) in one leaf (see
-    ``_trial_exact``); the kinetic energy's q̇ᵀq̇ is summed in index order."""
+    q̈ from equilibrium (the load ``series[k] @ pat``) and the output row (as
+    ``_write_output``) in one leaf (see ``_trial_exact``); the kinetic energy's q̇ᵀq̇ is
+    summed in index order."""
     n = w2.shape[0]
     m = P.shape[0]
+    npat = pat.shape[0]
     for i in range(n):
         q[i] = x[i]
         qd[i] = xd[i]
     for i in range(n):
-        acc = pext[k, i] - cd[i] * qd[i] - w2[i] * q[i]
+        acc = 0.0
+        for c in range(npat):
+            acc += series[k, c] * pat[c, i]
+        acc += -cd[i] * qd[i] - w2[i] * q[i]
         for j in range(m):
             acc -= P[j, i] * lam[j]
         qdd[i] = acc
@@ -134,8 +139,9 @@ def _step_output(k, w2, cd, P, pext, x, xd, q, qd, qdd, w, wd, lam, stuck, mass,
         out_energy[k, 3] = E_damp
         out_energy[k, 4] = E_fric
     # every array's last use in the exit block (see ``_trial_exact``)
-    used = (cd.shape[0] + P.shape[0] + pext.shape[0] + xd.shape[0] + qdd.shape[0] + w.shape[0]
-            + wd.shape[0] + lam.shape[0] + stuck.shape[0] + mass.shape[0] + out_q.shape[0]
+    used = (cd.shape[0] + P.shape[0] + series.shape[0] + pat.shape[0] + xd.shape[0]
+            + qdd.shape[0] + w.shape[0] + wd.shape[0] + lam.shape[0] + stuck.shape[0]
+            + mass.shape[0] + out_q.shape[0]
             + out_qd.shape[0] + out_qdd.shape[0] + out_w.shape[0] + out_wd.shape[0]
             + out_lam.shape[0] + out_stuck.shape[0] + out_energy.shape[0] + x.shape[0]
             + w2.shape[0] + q.shape[0] + qd.shape[0])
@@ -144,8 +150,18 @@ def _step_output(k, w2, cd, P, pext, x, xd, q, qd, qdd, w, wd, lam, stuck, mass,
 
 
 @_JIT
+def _modal_load(pat, ser, out):
+    """out = ser @ pat: the modal load of the load series' values ``ser`` (npat,)."""
+    for i in range(out.shape[0]):
+        acc = 0.0
+        for c in range(ser.shape[0]):
+            acc += ser[c] * pat[c, i]
+        out[i] = acc
+
+
+@_JIT
 def run_kernel_exact(
-    w2, cd, a1, fixed, P, mass, mus, mud, dt, ag, pext, pat, series, N, q_init, qd_init,
+    w2, cd, a1, fixed, P, mass, mus, mud, dt, ag, pat, series, N, q_init, qd_init,
     resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
     track_energy, max_events, max_substeps, cache_size,
     out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy,
@@ -154,9 +170,10 @@ def run_kernel_exact(
     """Integrate ``n_steps = ag.shape[0] - 1`` steps with exact modal propagators.
 
     Same interface and outputs as ``run_kernel`` (Newmark) except: ``a1`` (C = a1 K) or
-    ``fixed`` (no slider on the structure: the basis never changes), the load split
-    ``pext = series @ pat`` ((n_t, npat) time series of (npat, n) modal load patterns; ``pext``
-    itself is used for the accelerations), and ``cache_size`` (contact configurations kept).
+    ``fixed`` (no slider on the structure: the basis never changes), the modal load given
+    split as ``series @ pat`` ((n_t, npat) time series of (npat, n) modal load patterns, never
+    formed as a whole: a fresh (n_t, n) array costs its page faults), and ``cache_size``
+    (contact configurations kept).
     Returns (status, n_events, n_substeps, n_configs_built).
     """
     n = w2.shape[0]
@@ -196,7 +213,10 @@ def run_kernel_exact(
     _cfg_key(stuck, on_struct, key)
     _cfg_mass(P, mass, key, Ms_key)
     n_rank1 = 0
-    _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag[0], pext[0],
+    pe_t = np.empty(n)  # the modal load series @ pat at an instant
+    ser_t = np.empty(npat)
+    _modal_load(pat, series[0], pe_t)
+    _consistent_cfg(w2, cd, P, mass, mus, mud, on_struct, Ms_key, key, q, qd, ag[0], pe_t,
                     N[0], stuck, sig, cand, forced, qdd, wdd, lam)
     n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
                           ev_time, ev_slider, ev_kind)
@@ -231,8 +251,8 @@ def run_kernel_exact(
     ework = np.zeros(3)
     SER = np.empty((3, npat))  # load series at the start, the step's end, a trial's end
     ser0, sere = SER[0], SER[2]
-    Wn = np.empty((3, n))
-    pe_t, f0, fs = Wn[0], Wn[1], Wn[2]
+    Wn = np.empty((2, n))
+    f0, fs = Wn[0], Wn[1]
     # T0's g0 and x0 hold the current start state's values (set by an accepted sub-step,
     # void after a transition, which changes the state or the configuration)
     fresh = False
@@ -293,7 +313,7 @@ def run_kernel_exact(
                 whole = full and tau_end >= 1.0
                 if not whole:
                     _mode_matrices(nu2, cc, h_acc, Esub)
-                ag_b = _sample(ag, pext, N, step, tau_end, pe_t, N_e)
+                ag_b = _sample(ag, series, N, step, tau_end, ser_t, N_e)
                 Eacc = Efull if whole else Esub
                 _energy_substep(h_acc, Eacc, psi, nu2, cc, P, eta, etad, g0, g1, mass, mud,
                                 on_struct, stuck, sig, w, wd, ag0, ag_b, N0, N_e, ework,
@@ -312,7 +332,8 @@ def run_kernel_exact(
             if tau_end >= 1.0:
                 break
             # --- transition at t_e = (step + tau_end) dt (§5)
-            ag_e = _sample(ag, pext, N, step, tau_end, pe_t, N_e)
+            ag_e = _sample(ag, series, N, step, tau_end, ser_t, N_e)
+            _modal_load(pat, ser_t, pe_t)
             q[:] = x0  # Ψ η and Ψ η̇, bitwise as _to_physical
             qd[:] = xd0
             fresh = False
@@ -354,7 +375,7 @@ def run_kernel_exact(
         if status != STATUS_OK:
             break
         # Ψ η and Ψ η̇ of the last accepted sub-step (bitwise as _to_physical), q̈, output
-        status = _step_output(step + 1, w2, cd, P, pext, x0, xd0, q, qd, qdd, w, wd, lam,
+        status = _step_output(step + 1, w2, cd, P, series, pat, x0, xd0, q, qd, qdd, w, wd, lam,
                               stuck, mass, track_energy, E_in, E_damp, E_fric, out_q, out_qd,
                               out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
         if status != STATUS_OK:

@@ -122,7 +122,6 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             rows = slice(start, stop + 1)
             k = stop - start + 1
             ser = np.ascontiguousarray(series[rows])
-            pext = np.ascontiguousarray(ser @ pat)
             N = np.multiply.outer(gz[rows], mass)  # np.outer, clipped in place: one array
             np.clip(N, 0.0, None, out=N)
             ev = (ev_time[n_ev:], ev_slider[n_ev:], ev_kind[n_ev:])
@@ -131,7 +130,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             if use_exact:
                 st, ne, ns, nc = kern.run_kernel_exact(
                     w2c, cd, a1, not bool(np.any(on_structure)), P, mass, mus, mud, float(dt),
-                    ag[rows], pext, pat, ser, N, qs, qds,
+                    ag[rows], pat, ser, N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, cache_size,
                     *outs[:8], *ev,
@@ -140,7 +139,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
             else:
                 st, ne, ns = kern.run_kernel(
                     w2c, cd, Cq, diag, P, mass, mus, mud, rate, Q, h_th0, h_k, h_law, h_par, hst,
-                    float(dt), ag[rows], pext, N, qs, qds,
+                    float(dt), ag[rows], np.ascontiguousarray(ser @ pat), N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
                 )
