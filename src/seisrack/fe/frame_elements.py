@@ -76,18 +76,6 @@ class EndForceMaps:
 
 def end_force_maps(mesh: Any) -> EndForceMaps:
     """:class:`EndForceMaps` of ``mesh`` (the plane or the space beam-column, by ``mesh.ndm``)."""
-    L = mesh.lengths
-    if mesh.ndm == 2:
-        c, s = mesh.direction_cosines
-        T = e2.rotation(c, s)
-        k = e2.local_stiffness(mesh.E, mesh.A, mesh.I, L)
-        bars = np.zeros((0, 4, 4))
-    else:
-        X = mesh.nodes
-        T = e3.transformation_3d(e3.local_axes(X[mesh.elements[:, 0]],
-                                               X[mesh.elements[:, 1]], mesh.vecxz))
-        k = e3.local_stiffness_3d(mesh.E, mesh.G, mesh.A, mesh.Iy, mesh.I, mesh.J, L)
-        bars = e3.truss_matrices_3d(X[mesh.trusses[:, 0]], X[mesh.trusses[:, 1]],
-                                    E=mesh.truss_E, A=mesh.truss_A,
-                                    rho=mesh.truss_density)[0]
-    return EndForceMaps(T=T, kt=np.einsum("eij,ejk->eik", k, T), bars=bars)
+    T = local_frames(mesh)
+    bars = np.zeros((0, 4, 4)) if mesh.ndm == 2 else truss_matrices(mesh)[0]
+    return EndForceMaps(T=T, kt=np.einsum("eij,ejk->eik", local_stiffness(mesh), T), bars=bars)
