@@ -99,7 +99,13 @@ class Kept:
 
     def __init__(self, n_steps: int, save_every: int | None, nb: int, m: int, energy: bool,
                  nh: int = 0) -> None:
-        n_keep = kept_samples(n_steps, save_every)
+        self._sizes = (kept_samples(n_steps, save_every), nb, m, nh)
+        self.count = 0
+        self._made = False  # the arrays are made at the first copy: a run kept whole in one
+        # chunk adopts the chunk's buffers and never needs them
+
+    def _make(self) -> None:
+        n_keep, nb, m, nh = self._sizes
         self.q = np.empty((n_keep, nb))
         self.qd = np.empty((n_keep, nb))
         self.qdd = np.empty((n_keep, nb))
@@ -111,7 +117,7 @@ class Kept:
         self.hm = np.zeros((n_keep, nh))
         self.N = np.empty((n_keep, m))
         self.idx = np.empty(n_keep, dtype=np.int64)
-        self.count = 0
+        self._made = True
 
     def take(self, start: int, stop: int, n_steps: int, every: int | None,
              outs: tuple[np.ndarray, ...], N: np.ndarray) -> None:  # noqa: N803
@@ -130,8 +136,11 @@ class Kept:
                 (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck,
                  self.energy, self.hm) = outs
                 self.N, self.idx, self.count = N, sel, sel.size
+                self._made = True
                 return
             loc = slice(int(loc[0]), int(loc[-1]) + 1)
+        if not self._made:
+            self._make()
         a, b = self.count, self.count + sel.size
         for dst, src in zip(
             (self.q, self.qd, self.qdd, self.w, self.wd, self.lam, self.stuck, self.energy,
@@ -144,6 +153,8 @@ class Kept:
         self.count = b
 
     def result(self) -> tuple[np.ndarray, ...]:
+        if not self._made:
+            self._make()
         c = self.count
         return (self.q[:c], self.qd[:c], self.qdd[:c], self.w[:c], self.wd[:c], self.lam[:c],
                 self.stuck[:c], self.energy[:c], self.hm[:c], self.N[:c], self.idx[:c])
