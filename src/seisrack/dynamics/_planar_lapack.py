@@ -31,7 +31,7 @@ if _COMPILED:
     @_JIT
     def _syrk_lower(A, G, ng):
         """A += G[:ng]ᵀ G[:ng] on the lower triangle (A (r, r), G (>= ng, r), C-ordered)."""
-        if ng == 0:
+        if ng == 0 or A.shape[0] == 0:
             return
         ch = np.empty(2, dtype=np.uint8)
         ch[0] = _U
@@ -48,6 +48,8 @@ if _COMPILED:
     def _chol(A):
         """Lower Cholesky factor of the SPD matrix ``A`` into its lower triangle; False if
         ``A`` is not positive definite (or not finite)."""
+        if A.shape[0] == 0:  # every direction held quasi-statically: nothing to factorise
+            return True
         ch = np.empty(1, dtype=np.uint8)
         ch[0] = _U
         iv = np.empty(2, dtype=np.int32)

@@ -19,6 +19,7 @@ import numpy as np
 
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
+from seisrack.dynamics._quasi_static import QuasiStatic, stiff_directions
 from seisrack.dynamics._store import keep_index
 from seisrack.dynamics.axial import no_axial
 from seisrack.dynamics.basis import Basis
@@ -98,31 +99,40 @@ def run_planar_scheme(
     Q = hinges.operator(phi)[:nh]
     hst = hinges.initial_state()[:nh]
     mod, used = _kernel(backend)
+    # the directions too stiff for the step are held quasi-statically (_quasi_static.py): the
+    # kernel integrates the others
+    qs = QuasiStatic(stiff_directions(w2, P, sliders.mass, dt, bool(nh) or Co.size > 0
+                                      or hinges.axial is not None), pat, P, w2, dt)
+    dyn = qs.dyn
+    nk = nb - qs.count
     # writable: a read-only array (a compiled model's) is another numba specialisation
-    mass, mus, mud, kd, h_k, h_law, h_par, h_th0 = writable_all(
-        sliders.mass, sliders.mu_static, sliders.mu_dynamic, w2,
+    mass, mus, mud, kd, cdk, Pk, h_k, h_law, h_par, h_th0 = writable_all(
+        sliders.mass, sliders.mu_static, sliders.mu_dynamic, w2[dyn], cd[dyn], P[:, dyn],
         *(a[:nh] for a in (hinges.k, hinges.law, hinges.par, hinges.theta0)))
+    patk = pat[dyn]
     agx, agz = np.ascontiguousarray(ag[:, 0]), np.ascontiguousarray(ag[:, 1])
 
-    T_state = np.zeros((3, nb))
+    T_state = np.zeros((3, nk))
     S_state = np.zeros((6, 2 * m))
     stuck = np.ones(m, dtype=np.bool_)
     dirn = np.zeros(2 * m)
-    S = np.zeros((nb + 2, nb))  # the stuck pallets' mass and first moments (_s_update)
-    A = np.zeros((nb, nb))  # the last factorised Newton matrix, kept across chunks
+    S = np.zeros((nk + 2, nk))  # the stuck pallets' mass and first moments (_s_update)
+    A = np.zeros((nk, nk))  # the last factorised Newton matrix, kept across chunks
     fac = np.full(1, -1.0)  # its step length (-1: none)
     HW = np.zeros((4, nh))
-    ax = no_axial(nb) if hinges.axial is None else hinges.axial.reduced(phi)
+    ax = no_axial(nk) if hinges.axial is None else hinges.axial.reduced(phi)
     e_state = np.zeros(5)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
-    bufs = (np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)), np.empty((chunk + 1, nb)),
+    bufs = (np.empty((chunk + 1, nk)), np.empty((chunk + 1, nk)), np.empty((chunk + 1, nk)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
             np.empty((chunk + 1, nh)), np.empty((chunk + 1, 6 if track_energy else 0)))
+    full = tuple(np.empty((chunk + 1, nb)) for _ in range(3)) if qs.count else ()
     keep_idx = keep_index(n_steps, save_every)
-    kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in bufs]
+    kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype)
+            for b in (*full, *bufs[len(full):])]
     kept_N = np.empty((keep_idx.size, m))
     status, n_ev, n_sub, start = 0, 0, 0, 0
     stats = np.zeros(4, dtype=np.int64)
@@ -131,18 +141,23 @@ def run_planar_scheme(
             stop = min(start + chunk, n_steps)
             rows = slice(start, stop + 1)
             k = stop - start + 1
-            pext = np.ascontiguousarray(ser[rows] @ pat.T)
+            pext = np.ascontiguousarray(ser[rows] @ patk.T)
             N = np.ascontiguousarray(np.clip(np.outer(gz[rows], mass), 0.0, None))
             outs = tuple(b[:k] for b in bufs)
             left = max(int(max_events) - n_ev, 0)
             st, ne, ns, kd_done = mod.run_planar(
-                kd, cd, Co, P, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
+                kd, cdk, Co, Pk, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
                 _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
                 stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8], *ax)
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
+            if qs.count:
+                fk = tuple(f[:k] for f in full)
+                qs.fill(ser[rows], outs[5], outs[:3], fk,
+                        outs[8] if track_energy else None)
+                outs = (*fk, *outs[3:])
             t_chunk = np.arange(start, stop + 1) * dt
             if on_chunk is not None:
                 on_chunk(Chunk(t_chunk, outs[0], outs[1], outs[2], outs[5].reshape(k, m, 2),
@@ -181,7 +196,8 @@ def run_planar_scheme(
         sliding=ku.reshape(len(ku), m, 2), sliding_v=kv.reshape(len(kv), m, 2),
         friction=kl.reshape(len(kl), m, 2), normal=kept_N, stuck=ks, energy=energy,
         slider_dof=sliders.dof_x.copy(), events=events, status=status_text, backend=used,
-        n_substeps=n_sub, method="newmark", basis=bas.describe(), sample_index=keep_idx,
+        n_substeps=n_sub, method="newmark",
+        basis={**bas.describe(), "quasi_static": qs.count}, sample_index=keep_idx,
         work=dict(zip(("trials", "newton_iterations", "factorisations", "location_trials"),
                       (int(x) for x in stats), strict=True)),
         hinge_moment=khm, hinge_operator=Q, hinge_rotation0=h_th0)
