@@ -236,10 +236,60 @@ def _classify(stuck, dirn, mus, N, S0, e, cand, forced, old_stuck, turned, c_ful
             sn = np.sqrt(s[jx] ** 2 + s[jz] ** 2)
             if e[p] > -1e-9 * vs and sn <= max(0.1 * c_full[p], 1e-9 * vs):
                 cand[p] = True
-                wd[jx] = vn[jx]
-                wd[jz] = vn[jz]
-                s[jx] = 0.0
-                s[jz] = 0.0
+                turned[p] = True  # marks the snap for _snap_stops (reset by the caller)
+
+
+@_JIT
+def _snap_stops(P, S, mass, T0, S0, stuck, snap):
+    """Pallets at a located stop (``snap``, from :func:`_classify`) keep a small relative
+    velocity ``s`` (of the order of the location's tolerance): they are snapped onto their
+    supports by one impulsive friction contact, all together, the structure with its stuck
+    pallets taking the reaction (momentum kept): with ``X = (I + S)⁻¹ P_sᵀ`` (``S`` the stuck
+    pallets' mass in basis coordinates) and ``W = diag(1/m) + P_s X``, the impulses are
+    ``J = −W⁻¹ s``; the pallets' velocities change by ``J/m``, the structure's by ``−X J``
+    and the stuck pallets' with their supports. Returns the energy the contact dissipates,
+    ``½ sᵀ W⁻¹ s`` (exact: the kinetic energy lost), for the friction term."""
+    wd, s = S0[1], S0[4]
+    idx = np.flatnonzero(snap)
+    k = idx.shape[0]
+    if k == 0:
+        return 0.0
+    r = P.shape[1]
+    rows = np.empty(2 * k, dtype=np.int64)
+    sv = np.empty(2 * k)
+    for a in range(k):
+        for c in range(2):
+            rows[2 * a + c] = 2 * idx[a] + c
+            sv[2 * a + c] = s[2 * idx[a] + c]
+    J = np.zeros(2 * k)
+    X = np.zeros((r, 2 * k))
+    if r > 0:
+        Meff = S[:r, :].copy()
+        for i in range(r):
+            Meff[i, i] += 1.0
+        Ps = np.empty((2 * k, r))
+        for a in range(2 * k):
+            Ps[a, :] = P[rows[a], :]
+        X = np.ascontiguousarray(np.linalg.solve(Meff, np.ascontiguousarray(Ps.T)))
+        W = np.dot(Ps, X)
+    else:
+        W = np.zeros((2 * k, 2 * k))
+    for a in range(2 * k):
+        W[a, a] += 1.0 / mass[rows[a] // 2]
+    J = -np.linalg.solve(W, sv)
+    lost = -0.5 * np.dot(sv, J)
+    if r > 0:
+        dqd = -np.dot(X, J)
+        for i in range(r):
+            T0[1, i] += dqd[i]
+        dvn = np.dot(P, dqd)
+        for p in range(stuck.shape[0]):
+            if stuck[p]:
+                for c in range(2):
+                    wd[2 * p + c] += dvn[2 * p + c]
+    for a in range(2 * k):
+        wd[rows[a]] += J[a] / mass[rows[a] // 2]
+    return lost
 
 
 @_JIT
