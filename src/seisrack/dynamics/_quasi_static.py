@@ -24,6 +24,8 @@ over every direction), so the balance closes as the kernel's does.
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 import scipy.linalg
 
@@ -56,8 +58,10 @@ def stiff_directions(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float,
         return np.zeros(r, dtype=np.bool_)
     w2 = np.asarray(w2, dtype=float)
     m2 = np.repeat(np.asarray(mass, dtype=float), 2)
-    key = (float(dt), QUASI_STATIC_OMEGA_DT, QUASI_STATIC_SHIFT, w2.tobytes(), m2.tobytes(),
-           np.ascontiguousarray(P).tobytes())
+    digest = hashlib.blake2b(digest_size=16)
+    for a in (w2, m2, np.ascontiguousarray(P, dtype=float)):
+        digest.update(a.tobytes())
+    key = (float(dt), QUASI_STATIC_OMEGA_DT, QUASI_STATIC_SHIFT, P.shape, digest.digest())
     hit = _CACHE.get(key)
     if hit is not None:
         return hit.copy()
