@@ -270,7 +270,20 @@ def _snap_stops(P, S, mass, T0, S0, stuck, snap):
         Ps = np.empty((2 * k, r))
         for a in range(2 * k):
             Ps[a, :] = P[rows[a], :]
-        X = np.ascontiguousarray(np.linalg.solve(Meff, np.ascontiguousarray(Ps.T)))
+        # X = Meff⁻¹ Psᵀ by Cholesky (Meff is symmetric positive definite)
+        L = np.linalg.cholesky(Meff)
+        X = np.ascontiguousarray(Ps.T)
+        for c in range(2 * k):
+            for i in range(r):
+                acc = X[i, c]
+                for j in range(i):
+                    acc -= L[i, j] * X[j, c]
+                X[i, c] = acc / L[i, i]
+            for i in range(r - 1, -1, -1):
+                acc = X[i, c]
+                for j in range(i + 1, r):
+                    acc -= L[j, i] * X[j, c]
+                X[i, c] = acc / L[i, i]
         W = np.dot(Ps, X)
     else:
         W = np.zeros((2 * k, 2 * k))
