@@ -242,57 +242,59 @@ def _classify(stuck, dirn, mus, N, S0, e, cand, forced, old_stuck, turned, c_ful
 @_JIT
 def _snap_stops(P, S, mass, T0, S0, stuck, snap):
     """Pallets at a located stop (``snap``, from :func:`_classify`) keep a small relative
-    velocity ``s`` (of the order of the location's tolerance): they are snapped onto their
-    supports by one impulsive friction contact, all together, the structure with its stuck
-    pallets taking the reaction (momentum kept): with ``X = (I + S)⁻¹ P_sᵀ`` (``S`` the stuck
-    pallets' mass in basis coordinates) and ``W = diag(1/m) + P_s X``, the impulses are
-    ``J = −W⁻¹ s``; the pallets' velocities change by ``J/m``, the structure's by ``−X J``
-    and the stuck pallets' with their supports. Returns the energy the contact dissipates,
-    ``½ sᵀ W⁻¹ s`` (exact: the kinetic energy lost), for the friction term."""
+    velocity ``s`` (of the order of the location's tolerance; exactly zero when the stop fell
+    inside the step's return map): they are snapped onto their supports by one impulsive
+    friction contact, all together, the structure with its stuck pallets taking the reaction
+    (momentum kept): with ``X = (I + S)⁻¹ P_sᵀ`` (``S`` the stuck pallets' mass in basis
+    coordinates) and ``W = diag(1/m) + P_s X``, the impulses are ``J = −W⁻¹ s``; the
+    pallets' velocities change by ``J/m``, the structure's by ``−X J`` and the stuck pallets'
+    with their supports. Returns the energy the contact dissipates, ``½ sᵀ W⁻¹ s`` (exact:
+    the kinetic energy lost), for the friction term."""
     wd, s = S0[1], S0[4]
-    idx = np.flatnonzero(snap)
-    k = idx.shape[0]
+    k = 0
+    for p in range(snap.shape[0]):
+        if snap[p] and (s[2 * p] != 0.0 or s[2 * p + 1] != 0.0):
+            k += 1
+        else:
+            snap[p] = False
     if k == 0:
         return 0.0
     r = P.shape[1]
     rows = np.empty(2 * k, dtype=np.int64)
     sv = np.empty(2 * k)
-    for a in range(k):
-        for c in range(2):
-            rows[2 * a + c] = 2 * idx[a] + c
-            sv[2 * a + c] = s[2 * idx[a] + c]
-    J = np.zeros(2 * k)
-    X = np.zeros((r, 2 * k))
+    a = 0
+    for p in range(snap.shape[0]):
+        if snap[p]:
+            for c in range(2):
+                rows[2 * a + c] = 2 * p + c
+                sv[2 * a + c] = s[2 * p + c]
+            a += 1
+    W = np.zeros((2 * k, 2 * k))
+    X = np.zeros((2 * k, r))  # row a: (I + S)⁻¹ P_aᵀ
     if r > 0:
-        Meff = S[:r, :].copy()
+        L = np.empty((r, r))
         for i in range(r):
-            Meff[i, i] += 1.0
-        Ps = np.empty((2 * k, r))
+            for j in range(i + 1):
+                L[i, j] = S[i, j]
+            L[i, i] += 1.0
+        if not _chol(L):  # not reached: I + S is positive definite
+            return 0.0
         for a in range(2 * k):
-            Ps[a, :] = P[rows[a], :]
-        # X = Meff⁻¹ Psᵀ by Cholesky (Meff is symmetric positive definite)
-        L = np.linalg.cholesky(Meff)
-        X = np.ascontiguousarray(Ps.T)
-        for c in range(2 * k):
             for i in range(r):
-                acc = X[i, c]
-                for j in range(i):
-                    acc -= L[i, j] * X[j, c]
-                X[i, c] = acc / L[i, i]
-            for i in range(r - 1, -1, -1):
-                acc = X[i, c]
-                for j in range(i + 1, r):
-                    acc -= L[j, i] * X[j, c]
-                X[i, c] = acc / L[i, i]
-        W = np.dot(Ps, X)
-    else:
-        W = np.zeros((2 * k, 2 * k))
+                X[a, i] = P[rows[a], i]
+            _chol_solve(L, X[a])
+        for a in range(2 * k):
+            for b in range(2 * k):
+                W[a, b] = np.dot(P[rows[a]], X[b])
     for a in range(2 * k):
         W[a, a] += 1.0 / mass[rows[a] // 2]
     J = -np.linalg.solve(W, sv)
     lost = -0.5 * np.dot(sv, J)
     if r > 0:
-        dqd = -np.dot(X, J)
+        dqd = np.zeros(r)
+        for a in range(2 * k):
+            for i in range(r):
+                dqd[i] -= X[a, i] * J[a]
         for i in range(r):
             T0[1, i] += dqd[i]
         dvn = np.dot(P, dqd)
