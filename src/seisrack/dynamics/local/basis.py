@@ -25,12 +25,14 @@ from seisrack.errors import InputError, SolverError
 _LOG = logging.getLogger(__name__)
 
 #: relative energy below which a direction of a slice is dropped (of a unit-energy load
-#: response). On the 150-pallet warehouse example, 20 s of two EC8 components: at 0.1 (782
-#: vectors) every pallet's peak sliding is within 0.84 mm of the planar engine with its
-#: basis tightened to 3e-2, level peaks within 0.14 %, the same 38 falls within 4 ms; at 0.2
-#: (696 vectors) 134 of 150 pallets within 1 mm and level peaks within 0.9 %
-#: (docs/theory/local_engine.md §6)
-DEFAULT_TOL = 0.1
+#: response). 20 s of two EC8 components against the planar engine with its basis tightened
+#: to 0.015 at dt 2.5 ms (benchmarks/results/local_vs_planar_10.md, _20.md): at 0.03 every
+#: pallet's peak sliding is within 0.5 % of the largest peak or 1 mm, the level peaks within
+#: 0.09 % (150 pallets, 912 vectors) and 0.07 % (300 pallets, 1754 vectors), the same falls
+#: within one step, for 13 % and 17 % more run time than at 0.1; at 0.1 (782 and 1485
+#: vectors) the 300-pallet row had 13 pallets beyond, level peaks 0.39 % off and two falls
+#: more (docs/theory/local_engine.md §6)
+DEFAULT_TOL = 0.03
 #: slices on each side of a slice in its patch
 DEFAULT_PATCH = 1
 
