@@ -338,8 +338,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                     c_full[p] = 0.5 * dt * mud[p] * Ne[p] / mass[p]
                 _classify(stuck, dirn, mus, Ne, S0, e_hi, cand, forced, old_stuck, turned,
                           c_full, frozen)
-                E_fric += _snap_stops(P, S, mass, T0, S0, stuck, turned)
-                _fill_relative(P, T0, S0)
+                lost = _snap_stops(P, S, mass, T0, S0, stuck, turned)
+                if lost > 0.0:  # the structure's velocity moved: every support's with it
+                    E_fric += lost
+                    _fill_relative(P, T0, S0)
                 _minus_qtz(pe, Q, hz, pz)
                 if axial:
                     _axial_force(AA, AG, Ao, As, Ac, T0[0], dn, gw, fb)

@@ -107,7 +107,8 @@ def run_planar_scheme(
     nk = nb - qs.count
     # writable: a read-only array (a compiled model's) is another numba specialisation
     mass, mus, mud, kd, cdk, Pk, h_k, h_law, h_par, h_th0 = writable_all(
-        sliders.mass, sliders.mu_static, sliders.mu_dynamic, w2[dyn], cd[dyn], P[:, dyn],
+        sliders.mass, sliders.mu_static, sliders.mu_dynamic, w2[dyn], cd[dyn],
+        np.ascontiguousarray(P[:, dyn]),  # a column mask gives Fortran order
         *(a[:nh] for a in (hinges.k, hinges.law, hinges.par, hinges.theta0)))
     patk = pat[dyn]
     agx, agz = np.ascontiguousarray(ag[:, 0]), np.ascontiguousarray(ag[:, 1])
