@@ -2,11 +2,12 @@
 (source shared by both backends).
 
 ``_consistent`` decides which sliders stick or slide at an instant (start of the run, or a
-located event) and computes the consistent accelerations; ``_accel_fixed`` recomputes the
-accelerations from equilibrium for given slider forces; ``_newmark_end`` completes a trial
-step (linear ``_trial`` and nonlinear ``_nl_trial``) once its generalized forces are known.
-Loaded before ``_kernel_hinge.py`` and ``_kernel.py`` into the numba namespace (see
-``_kernel_numba.py``); ``docs/theory/stick_slip_engine.md`` §3 and §5.
+located event) and computes the consistent accelerations, in the structure's coordinates with
+the stuck sliders' configuration mass (shared with the exact kernel); ``_accel_fixed``
+recomputes the accelerations from equilibrium for given slider forces; ``_newmark_end``
+completes a trial step (linear ``_trial`` and nonlinear ``_nl_trial``) once its generalized
+forces are known. Loaded before ``_kernel_hinge.py`` and ``_kernel.py`` into the numba
+namespace (see ``_kernel_numba.py``); ``docs/theory/stick_slip_engine.md`` §3 and §5.
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
@@ -17,19 +18,7 @@ try:  # names injected by the loader when executed after ``_events.py`` and ``_l
     _release_worst  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, _apply_candidates, _release_worst
-    from seisrack.dynamics._linalg import _damp_mul, _mv, _solve
-
-
-@_JIT
-def _stuck_index(stuck, n_stuck):
-    """Indices of the ``n_stuck`` stuck sliders."""
-    idx = np.empty(n_stuck, dtype=np.int64)
-    k = 0
-    for j in range(stuck.shape[0]):
-        if stuck[j]:
-            idx[k] = j
-            k += 1
-    return idx
+    from seisrack.dynamics._linalg import _damp_mul, _mv
 
 
 @_JIT
@@ -75,56 +64,126 @@ def _accel_fixed(kd, cd, Cq, diag, P, mass, q, qd, ag, pext, lam, qdd, wdd):
 
 
 @_JIT
-def _consistent(kd, cd, Cq, diag, P, B, mass, mus, mud, q, qd, ag, pext, N, stuck, sig,
-                cand, forced, qdd, wdd, lam):
+def _free_accel(kd, cd, Cq, diag, q, qd, pext, base):
+    """base = pext − C q̇ − K q: the structure's acceleration without slider forces."""
+    _damp_mul(cd, Cq, diag, qd, base)
+    for i in range(kd.shape[0]):
+        base[i] = pext[i] - base[i] - kd[i] * q[i]
+
+
+@_JIT
+def _rank1(Ms, p, c):
+    """Ms += c p pᵀ (a slider of mass c sticking, or -c unsticking)."""
+    r = p.shape[0]
+    for i in range(r):
+        pi = c * p[i]
+        if pi != 0.0:
+            for k in range(r):
+                Ms[i, k] += pi * p[k]
+
+
+@_JIT
+def _cfg_key(stuck, on_struct, key):
+    for j in range(stuck.shape[0]):
+        key[j] = stuck[j] and on_struct[j]
+
+
+@_JIT
+def _cfg_mass(P, mass, key, Ms):
+    """Ms = I + P_Sᵀ diag(m_S) P_S for the stuck set ``key`` (from scratch)."""
+    r = P.shape[1]
+    for i in range(r):
+        for k in range(r):
+            Ms[i, k] = 0.0
+        Ms[i, i] = 1.0
+    for j in range(P.shape[0]):
+        if key[j]:
+            _rank1(Ms, P[j], mass[j])
+
+
+@_JIT
+def _cfg_update(P, mass, stuck, on_struct, key, Ms_key, n_rank1):
+    """Bring the configuration mass ``Ms_key`` of the stuck set ``key`` to ``stuck`` by
+    rank-one changes (rebuilt after 1000 of them, which bounds their round-off). Returns
+    (whether the set changed, the rank-one count since the last rebuild)."""
+    changed = False
+    for j in range(stuck.shape[0]):
+        now = stuck[j] and on_struct[j]
+        if now != key[j]:
+            _rank1(Ms_key, P[j], mass[j] if now else -mass[j])
+            n_rank1 += 1
+            key[j] = now
+            changed = True
+    if n_rank1 > 1000:
+        _cfg_mass(P, mass, key, Ms_key)
+        n_rank1 = 0
+    return changed, n_rank1
+
+
+@_JIT
+def _spd_solve(A, b, x):
+    """x = A⁻¹ b for a small symmetric positive-definite A (Cholesky)."""
+    r = A.shape[0]
+    L = np.linalg.cholesky(A)
+    for i in range(r):
+        acc = b[i]
+        for k in range(i):
+            acc -= L[i, k] * x[k]
+        x[i] = acc / L[i, i]
+    for i in range(r - 1, -1, -1):
+        acc = x[i]
+        for k in range(i + 1, r):
+            acc -= L[k, i] * x[k]
+        x[i] = acc / L[i, i]
+
+
+@_JIT
+def _consistent(P, mass, mus, mud, on_struct, Ms_key, key, base, ag, N, stuck, sig, cand,
+                forced, qdd, wdd, lam):
     """Decide the contact state at an instant and compute consistent accelerations.
 
+    ``base``: the structure's acceleration without slider forces (``_free_accel``).
     ``cand``: sliders at zero relative velocity whose state must be decided (stick if the force
     needed to keep them stuck is within mu_s N, else slide opposite to that force).
     ``forced``: sliders that must slide with the given ``sig`` (slip onset just located).
-    Updates ``stuck`` and ``sig`` in place; writes accelerations ``qdd``, ``wdd`` and ``lam``.
+    Stick every candidate, then release the most overloaded stuck slider one at a time. Solved
+    in the structure's coordinates: the stuck sliders' masses join the configuration mass
+    ``I + P_Sᵀ m_S P_S`` (rank-one changes from ``Ms_key``, the mass of the stuck set ``key``),
+    so the cost is O(m r + r³), never O(m²). Updates ``stuck`` and ``sig`` in place; writes
+    accelerations ``qdd``, ``wdd`` and ``lam``.
     """
-    n = kd.shape[0]
+    r = base.shape[0]
     m = mass.shape[0]
-    tmp = np.empty(n)
-    _damp_mul(cd, Cq, diag, qd, tmp)
-    base = np.empty(n)  # structural acceleration without slider forces
-    for i in range(n):
-        base[i] = pext[i] - tmp[i] - kd[i] * q[i]
-    pb = np.empty(m)
-    _mv(P, base, pb)
-    sdot0 = np.empty(m)
-    for j in range(m):
-        sdot0[j] = -ag - pb[j]
     _apply_candidates(cand, forced, stuck)
+    Mt = Ms_key.copy()
+    for j in range(m):
+        if on_struct[j] and stuck[j] != key[j]:
+            _rank1(Mt, P[j], mass[j] if stuck[j] else -mass[j])
+    rhs = np.empty(r)
     for _it in range(2 * m + 2):
-        n_stuck = 0
+        for i in range(r):
+            rhs[i] = base[i]
         for j in range(m):
             if stuck[j]:
-                n_stuck += 1
+                f = -mass[j] * ag
             else:
                 lam[j] = -mud[j] * N[j] * sig[j]
-        if n_stuck > 0:
-            idx = _stuck_index(stuck, n_stuck)
-            Bss = np.empty((n_stuck, n_stuck))
-            r = np.empty(n_stuck)
-            for a in range(n_stuck):
-                acc = sdot0[idx[a]]
-                for j in range(m):
-                    if not stuck[j]:
-                        acc += B[idx[a], j] * lam[j]
-                r[a] = -acc
-                for c in range(n_stuck):
-                    Bss[a, c] = B[idx[a], idx[c]]
-            x = _solve(Bss, r.reshape((n_stuck, 1)))[:, 0]
-            for a in range(n_stuck):
-                lam[idx[a]] = x[a]
-        # release the most overloaded stuck slider, one at a time
-        if _release_worst(stuck, forced, lam, mus, N, sig) < 0:
+                f = -lam[j]
+            if on_struct[j] and f != 0.0:
+                for i in range(r):
+                    rhs[i] += P[j, i] * f
+        _spd_solve(Mt, rhs, qdd)
+        for j in range(m):
+            if stuck[j]:
+                acc = 0.0
+                if on_struct[j]:
+                    for i in range(r):
+                        acc += P[j, i] * qdd[i]
+                lam[j] = mass[j] * (acc + ag)
+        worst = _release_worst(stuck, forced, lam, mus, N, sig)
+        if worst < 0:
             break
-    ptl = np.empty(n)
-    _mv(np.ascontiguousarray(P.T), lam, ptl)
-    for i in range(n):
-        qdd[i] = base[i] - ptl[i]
+        if on_struct[worst]:
+            _rank1(Mt, P[worst], -mass[worst])
     for j in range(m):
         wdd[j] = -ag + lam[j] / mass[j]

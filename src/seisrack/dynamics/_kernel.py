@@ -13,13 +13,17 @@ Formulation (see ``docs/theory/stick_slip_engine.md``):
   support displacement, ``P.T @ lam`` maps slider forces back.
 * Newmark average acceleration (β = 1/4, γ = 1/2). Within one (sub)step the contact state is
   fixed: stuck sliders satisfy zero relative velocity at the end of the step, sliding sliders carry
-  ``lam = -mu_d N sign(s)``. The stuck forces solve a small SPD system ``A_SS lam_S = -b_S``.
+  ``lam = -mu_d N sign(s)`` (or their velocity-dependent law). The step, with any nonlinear
+  hinges, is ``_kernel_hinge._nl_trial``: one solve with the structure's (tangent) effective
+  stiffness with the stuck sliders' masses, never a matrix of the sliders.
 * Transitions are located *inside* the step: an event function per slider (``|lam| - mu_s N`` for
   stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by Illinois regula falsi
   (bisection safeguard) on the sub-step length, the step is split there, and the new contact
-  state is decided at the acceleration level (active set on ``B = diag(1/m) + P P^T``).
+  state is decided at the acceleration level (``_consistent``: an active set solved in the
+  structure's coordinates with the stuck sliders' masses, the configuration mass ``Ms_key``
+  kept by rank-one changes as in the exact kernel).
   Detection, location, transitions and output are the event core in ``_events.py``, shared
-  with the exact kernel; this file holds the Newmark trial step and its driver.
+  with the exact kernel; this file holds the driver.
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
@@ -31,9 +35,11 @@ try:  # names injected by the loader when executed after ``_events.py``
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._contact import (
         _accel_fixed,
+        _cfg_key,
+        _cfg_mass,
+        _cfg_update,
         _consistent,
-        _newmark_end,
-        _stuck_index,
+        _free_accel,
     )
     from seisrack.dynamics._events import (
         _JIT,
@@ -61,72 +67,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _mu_now,
         _nl_trial,
     )
-    from seisrack.dynamics._linalg import _damp_mul, _hmat_pt, _mm_pt, _modal_solve, _mv, _solve
-
-
-@_JIT
-def _trial(
-    h, kd, cd, Cq, diag, P, HPt, G, mass, mud, q0, qd0, qdd0, w0, wd0, wdd0,
-    ag1, pext1, N1, stuck, sig, Ainv_cache, cache_ok,
-    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, tmp, rhs, qhat, vnode, b, f,
-):
-    """One Newmark step of length h with a fixed contact state; writes the end state.
-
-    ``HPt`` (n, m) and ``G = P H P^T`` (m, m) must correspond to ``h``. When ``cache_ok`` is true,
-    ``Ainv_cache`` holds the inverse of the stuck-stuck block of A for the current stuck set.
-    Returns True when it (re)computed the inverse into ``Ainv_cache``.
-    """
-    n = kd.shape[0]
-    m = mass.shape[0]
-    c1 = 4.0 / h
-    c2 = 2.0 / h
-    # incremental form: K_hat dq = p1 - K q0 + C qd0 + (4/h) qd0 + qdd0 (no cancellation for
-    # short sub-steps, where 4/h^2 would amplify the round-off of q0)
-    _damp_mul(cd, Cq, diag, qd0, rhs)
-    for i in range(n):
-        rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
-    _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)  # qhat holds the free increment
-    # support velocity of the "free" (lam = 0) prediction
-    for i in range(n):
-        tmp[i] = c2 * qhat[i] - qd0[i]
-    _mv(P, tmp, vnode)
-    for j in range(m):
-        b[j] = wd0[j] + 0.5 * h * (wdd0[j] - ag1) - vnode[j]
-    # sliding forces are known
-    n_stuck = 0
-    for j in range(m):
-        if stuck[j]:
-            n_stuck += 1
-            lam1[j] = 0.0
-        else:
-            lam1[j] = -mud[j] * N1[j] * sig[j]
-    recomputed = False
-    if n_stuck > 0:
-        idx = _stuck_index(stuck, n_stuck)
-        rhs_s = np.empty(n_stuck)
-        for a in range(n_stuck):
-            ja = idx[a]
-            acc = b[ja]
-            for j in range(m):
-                if not stuck[j]:
-                    acc += c2 * G[ja, j] * lam1[j]
-            rhs_s[a] = -acc
-        if not cache_ok:
-            Ass = np.empty((n_stuck, n_stuck))
-            for a in range(n_stuck):
-                for c in range(n_stuck):
-                    Ass[a, c] = c2 * G[idx[a], idx[c]]
-                Ass[a, a] += 0.5 * h / mass[idx[a]]
-            Ainv_cache[:n_stuck, :n_stuck] = _solve(Ass, np.eye(n_stuck))
-            recomputed = True
-        for a in range(n_stuck):
-            acc = 0.0
-            for c in range(n_stuck):
-                acc += Ainv_cache[a, c] * rhs_s[c]
-            lam1[idx[a]] = acc
-    _newmark_end(h, HPt, lam1, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
-                 q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vnode)
-    return recomputed
+    from seisrack.dynamics._linalg import _damp_mul, _hmat_pt, _mv
 
 
 @_JIT
@@ -159,19 +100,10 @@ def run_kernel(
     m = mass.shape[0]
     nh = hk.shape[0]
     n_t = ag.shape[0]
-    nl = nh > 0
-    for j in range(m):
-        if rate[j] > 0.0:
-            nl = True
     D = np.empty((m + nh, n))  # [P; Q]: P alone on the linear path
     D[:m] = P
     D[m:] = Q
-    # operators for the regular step
-    HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, D)
-    G_dt = _mm_pt(D, np.ascontiguousarray(HPt_dt.T))
-    B = _mm_pt(P, P)
-    for j in range(m):
-        B[j, j] += 1.0 / mass[j]
+    HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, D)  # operator of the regular step
     # state at the start of the (sub)step: T0 rows q, qd, qdd; S0 rows w, wd, lam, s, wdd
     T0 = np.zeros((3, n))
     T0[0] = q_init
@@ -184,9 +116,12 @@ def run_kernel(
     Wh = np.zeros((4, nh))  # hinge moments, corrections (committed), and trial copies
     hM, hz, hM_t, hz_t = Wh[0], Wh[1], Wh[2], Wh[3]
     hst_t = hst.copy()
-    wn = np.empty((3, n))  # scratch of the nonlinear trial
-    wx = np.empty((9, m + nh))
-    Jn = np.empty((m + nh, m + nh))
+    wn = np.empty((4, n))  # scratch of the trial step, and its Newton core's cache
+    wx = np.empty((12, m + nh))
+    Kc = np.zeros((2, n, n))
+    piv = np.zeros(n, dtype=np.int64)
+    om = np.zeros(nh)
+    cmeta = np.zeros(3)
     _hinge_state(Q, hth0, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
     mu_now = mud.copy()
     pe_eff = np.empty(n)
@@ -195,8 +130,17 @@ def run_kernel(
         s0[j] = wd[j] - s0[j]
     _mu_now(mus, mud, rate, stuck, s0, mu_now)
     _minus_qtz(pext[0], Q, hz, pe_eff)
-    _consistent(kd, cd, Cq, diag, P, B, mass, mus, mu_now, q, qd, ag[0], pe_eff, N[0],
-                stuck, sig, cand, forced, qdd, wdd, lam)
+    on_struct = np.ones(m, dtype=np.bool_)
+    key = np.zeros(m, dtype=np.bool_)
+    Ms_key = np.empty((n, n))  # I + Σ_stuck m_j p_j p_jᵀ, the configuration mass
+    _cfg_key(stuck, on_struct, key)
+    _cfg_mass(P, mass, key, Ms_key)
+    base = np.empty(n)
+    _free_accel(kd, cd, Cq, diag, q, qd, pe_eff, base)
+    _consistent(P, mass, mus, mu_now, on_struct, Ms_key, key, base, ag[0], N[0], stuck, sig,
+                cand, forced, qdd, wdd, lam)
+    _chg, n_rank1 = _cfg_update(P, mass, stuck, on_struct, key, Ms_key, 0)
+    n_cfg = 0.0  # changes of the stuck set (the nonlinear trial's cache key)
     n_ev = _record_events(cand, sig, stuck, sig, t_offset, 0, max_events,
                           ev_time, ev_slider, ev_kind)
     status = STATUS_OK
@@ -205,14 +149,11 @@ def run_kernel(
     T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(3, n, 5, m)
     q1, qd1, qdd1 = T1[0], T1[1], T1[2]
     w1, wd1, lam1, s1, wdd1 = S1[0], S1[1], S1[2], S1[3], S1[4]
-    Ainv = np.zeros((m, m))
-    cache_ok = False
     n_sub_total = 0
-    Wn = np.empty((8, n))  # scratch
+    Wn = np.empty((4, n))  # scratch
     pe0, pe1, tmpn, tmpn2 = Wn[0], Wn[1], Wn[2], Wn[3]
-    wk_t, wk_r, wk_q, wk_f = Wn[4], Wn[5], Wn[6], Wn[7]
-    Wm = np.empty((4, m))
-    wk_v, wk_b, vn0, N_e = Wm[0], Wm[1], Wm[2], Wm[3]
+    Wm = np.empty((3, m))
+    wk_v, vn0, N_e = Wm[0], Wm[1], Wm[2]
 
     _write_output(0, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy, E_in, E_damp,
                   E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
@@ -231,24 +172,13 @@ def run_kernel(
             for i in range(n):
                 pe1[i] = pext[step + 1, i]
             ag1 = ag[step + 1]
-            if full:
-                HPt, G = HPt_dt, G_dt
-            else:
-                HPt = _hmat_pt(kd, cd, Cq, diag, hrem, D)
-                G = _mm_pt(D, np.ascontiguousarray(HPt.T))
-            if nl:  # hinges / velocity-dependent friction (_kernel_hinge.py)
-                hz_t[:] = hz
-                st_tr = _nl_trial(
-                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hth0, hk,
-                    hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
-                    stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Jn)
-            else:
-                use_cache = cache_ok and full
-                recomputed = _trial(
-                    hrem, kd, cd, Cq, diag, D, HPt, G, mass, mud, q, qd, qdd, w, wd, wdd, ag1,
-                    pe1, N[step + 1], stuck, sig, Ainv, use_cache, q1, qd1, qdd1, w1, wd1, wdd1,
-                    lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
-                cache_ok = (cache_ok or recomputed) and full
+            HPt = HPt_dt if full else _hmat_pt(kd, cd, Cq, diag, hrem, D)
+            hz_t[:] = hz
+            st_tr = _nl_trial(
+                hrem, kd, cd, Cq, diag, D, HPt, mass, mus, mud, rate, hth0, hk, hlaw, hpar,
+                hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1], stuck, sig,
+                q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key, n_cfg, Kc,
+                piv, om, cmeta)
             if st_tr != STATUS_OK:
                 status = st_tr
                 break
@@ -268,19 +198,12 @@ def run_kernel(
                     ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
                     hsub = th * hrem
                     HPt = _hmat_pt(kd, cd, Cq, diag, hsub, D)
-                    G = _mm_pt(D, np.ascontiguousarray(HPt.T))
-                    if nl:
-                        hz_t[:] = hz
-                        st_tr = _nl_trial(
-                            hsub, kd, cd, Cq, diag, D, HPt, G, mass, mus, mud, rate, hth0, hk,
-                            hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e,
-                            stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t,
-                            wn, wx, Jn)
-                    else:
-                        _trial(hsub, kd, cd, Cq, diag, D, HPt, G, mass, mud, q, qd, qdd, w, wd,
-                               wdd, ag_e, tmpn, N_e, stuck, sig, Ainv, False, q1, qd1, qdd1,
-                               w1, wd1, wdd1, lam1, s1, wk_t, wk_r, wk_q, wk_v, wk_b, wk_f)
-                    cache_ok = False
+                    hz_t[:] = hz
+                    st_tr = _nl_trial(
+                        hsub, kd, cd, Cq, diag, D, HPt, mass, mus, mud, rate, hth0, hk, hlaw,
+                        hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e, stuck,
+                        sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
+                        n_cfg, Kc, piv, om, cmeta)
                     if st_tr != STATUS_OK:
                         status = st_tr
                         break
@@ -337,9 +260,12 @@ def run_kernel(
             _classify(stuck, sig, lam, s1, wd, vn0, mus, N_e, tolF, e_try, old_stuck, old_sig,
                       cand, forced)
             _mu_now(mus, mud, rate, stuck, s0, mu_now)
-            _consistent(kd, cd, Cq, diag, P, B, mass, mus, mu_now, q, qd, ag_e, tmpn, N_e,
-                        stuck, sig, cand, forced, qdd, wdd, lam)
-            cache_ok = False
+            _free_accel(kd, cd, Cq, diag, q, qd, tmpn, base)
+            _consistent(P, mass, mus, mu_now, on_struct, Ms_key, key, base, ag_e, N_e, stuck,
+                        sig, cand, forced, qdd, wdd, lam)
+            chg, n_rank1 = _cfg_update(P, mass, stuck, on_struct, key, Ms_key, n_rank1)
+            if chg:
+                n_cfg += 1.0
             n_ev = _record_events(old_stuck, old_sig, stuck, sig,
                                   t_offset + (step + tau_end) * dt, n_ev, max_events,
                                   ev_time, ev_slider, ev_kind)

@@ -35,6 +35,7 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_kernel.py``
     _consistent  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
+    from seisrack.dynamics._contact import _cfg_key, _cfg_mass, _cfg_update
     from seisrack.dynamics._events import (
         _JIT,
         STATUS_NONFINITE,
@@ -54,13 +55,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _substep_end,
         _write_output,
     )
-    from seisrack.dynamics._exact_config import (
-        _cfg_key,
-        _cfg_mass,
-        _consistent_cfg,
-        _find_config,
-        _rank1,
-    )
+    from seisrack.dynamics._exact_config import _consistent_cfg, _find_config
     from seisrack.dynamics._exact_modes import _energy_substep, _mode_matrices, _trial_exact
     from seisrack.dynamics._linalg import _mv
 
@@ -347,21 +342,9 @@ def run_kernel_exact(
             n_ev = _record_events(old_stuck, old_sig, stuck, sig,
                                   t_offset + (step + tau_end) * dt, n_ev, max_events,
                                   ev_time, ev_slider, ev_kind)
-            changed = False
-            for j in range(m):
-                if on_struct[j] and stuck[j] != old_stuck[j]:
-                    changed = True
+            changed, n_rank1 = _cfg_update(P, mass, stuck, on_struct, key, Ms_key, n_rank1)
             if changed:
                 stamp += 1
-                for j in range(m):
-                    now = stuck[j] and on_struct[j]
-                    if now != key[j]:
-                        _rank1(Ms_key, P[j], mass[j] if now else -mass[j])
-                        n_rank1 += 1
-                        key[j] = now
-                if n_rank1 > 1000:  # bound the round-off of many rank-one updates
-                    _cfg_mass(P, mass, key, Ms_key)
-                    n_rank1 = 0
                 slot, built = _find_config(key, Ms_key, cfg_key, cfg_valid, cfg_stamp, stamp,
                                            w2, cd, a1, fixed, pat, dt, c_psi, c_psitm, c_nu2,
                                            c_cc, c_gpat, c_E)

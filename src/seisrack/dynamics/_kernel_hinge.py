@@ -1,10 +1,10 @@
-"""Newmark trial step with nonlinear hinges and velocity-dependent friction (issue #12).
+"""Newmark trial step of the line kernel, with nonlinear hinges and velocity-dependent friction
+(issue #12) when there are any.
 
 Same source for the numba build and the pure-Python twin (see ``_kernel_numba.py``). Called by
-``run_kernel`` (``_kernel.py``) in place of its linear ``_trial`` when the structure has
-hinges with a hysteresis law or a slider has velocity-dependent friction; the event core
-(``_events.py``) and the driver are unchanged, so stick/slip events are located inside the step
-exactly as on the linear path. See ``docs/theory/nonlinear_hinges.md``.
+``run_kernel`` (``_kernel.py``) for every (sub)step, linear or not; the event core
+(``_events.py``) and the driver locate stick/slip events inside the step. See
+``docs/theory/nonlinear_hinges.md`` and ``docs/theory/stick_slip_engine.md`` §3.
 
 Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``):
 
@@ -19,7 +19,9 @@ Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``
 * unknowns ``x = [λ (m sliders), θ (n_h hinges)]``, residuals
   stuck ``j``: relative velocity ``s_j(x) = 0``; sliding ``j``: ``λ_j + N_j σ_j μ_j(|s_j|) = 0``;
   hinge ``i``: ``θ_i − θ0_i − Q_i (q₀ + Δq(x)) = 0``; solved by Newton with the laws' consistent
-  tangents (``D = [P; Q]``, ``GG = D K̂⁻¹ Dᵀ``: every block the Jacobian needs);
+  tangents (``D = [P; Q]``); each Newton step is one solve with an n × n core, the tangent
+  effective stiffness with the stuck pallets' masses (Woodbury; ``_nl_trial``), whose factors
+  are kept while the step length, the contact state and the hinges' branches hold;
 * velocity-dependent friction while sliding: ``μ(v) = μ_d + (μ_s − μ_d) e^(−a v)``, equal to
   μ_s at v = 0 (continuous with the static threshold) and to Coulomb's μ_d as ``a → ∞``.
 """
@@ -31,14 +33,16 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_hysteresis.py`` and ``_linalg.py``
     _hyst_trial_at  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    from seisrack.dynamics._contact import _newmark_end
+    from seisrack.dynamics._contact import _newmark_end, _rank1
     from seisrack.dynamics._events import _JIT
     from seisrack.dynamics._hysteresis import HYST_S_THETA, _hyst_trial_at
-    from seisrack.dynamics._linalg import _damp_mul, _modal_solve, _mv, _solve_into
+    from seisrack.dynamics._lapack import _chol, _chol_solve
+    from seisrack.dynamics._linalg import _damp_mul, _lu_into, _lu_solve, _modal_solve, _mv
 
 STATUS_NEWTON = 4
 _NEWTON_MAX = 60
 _NEWTON_DAMPED = 20  # after this many iterations the steps are halved (breaks branch cycling)
+_REBUILD = 4000.0  # rank-one updates of the Newton core's hinge sum before it is rebuilt
 
 
 @_JIT
@@ -81,16 +85,90 @@ def _minus_qtz(pe, Q, hz, out):
 
 
 @_JIT
+def _core_weights(Q, zp, om, Kc, cmeta):
+    """Bring ``Kc[0] = Σ_i zp_i q_iᵀ q_i`` (``q_i``: hinge ``i``'s row of ``Q``; ``zp_i = k_t −
+    k_i``, zero on its elastic branch) up to date by rank-one updates; ``om`` holds the weights
+    it carries. Rebuilt from them every ``_REBUILD`` updates (bounds the round-off drift).
+    Returns True when any weight changed."""
+    changed = False
+    for i in range(om.shape[0]):
+        dw = zp[i] - om[i]
+        if dw != 0.0:
+            changed = True
+            om[i] = zp[i]
+            cmeta[1] += 1.0
+            _rank1(Kc[0], Q[i], dw)
+    if cmeta[1] > _REBUILD:
+        Kc[0, :, :] = 0.0
+        for i in range(om.shape[0]):
+            if om[i] != 0.0:
+                _rank1(Kc[0], Q[i], om[i])
+        cmeta[1] = 0.0
+    return changed
+
+
+@_JIT
+def _core_factor(kd, cd, Cq, diag, h, Ms_key, Kc, sw, D, piv):
+    """Factors, into ``Kc[1]``, of the Newton core ``K̂(h) + (4/h²)(Ms_key − I) + Kc[0] +
+    Σ_j sw_j p_j p_jᵀ``: the structure's tangent effective stiffness with its stuck pallets'
+    masses (``Ms_key``: the configuration mass ``I + Σ_stuck m_j p_j p_jᵀ``; ``sw``: sliding
+    pallets' velocity-dependent friction). Cholesky (lower triangle) when it is positive
+    definite, else LU with pivoting (softening tangents; ``piv[0] < 0`` marks the Cholesky
+    factor). Returns False if singular."""
+    n = kd.shape[0]
+    A = Kc[1]
+    c0 = 4.0 / (h * h)
+    for lu in range(2):
+        for r in range(n):
+            for c in range(n if lu else r + 1):
+                A[r, c] = c0 * Ms_key[r, c] + Kc[0, r, c]
+                if not diag:
+                    A[r, c] += 2.0 / h * Cq[r, c]
+            A[r, r] += kd[r]
+            if diag:
+                A[r, r] += 2.0 / h * cd[r]
+        for j in range(sw.shape[0]):
+            if sw[j] != 0.0:
+                _rank1(A, D[j], sw[j])
+        if lu:
+            return _lu_into(A, piv)
+        if _chol(A):
+            piv[0] = -1
+            return True
+    return False
+
+
+@_JIT
+def _core_solve(Kc, piv, x):
+    """Solve the core's factors (``_core_factor``) for ``x`` in place."""
+    if piv[0] < 0:
+        _chol_solve(Kc[1], x)
+    else:
+        _lu_solve(Kc[1], piv, x)
+
+
+@_JIT
 def _nl_trial(
-    h, kd, cd, Cq, diag, D, HDt, GG, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
+    h, kd, cd, Cq, diag, D, HDt, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
     q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
-    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, J,
+    q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, Ms_key, n_cfg, Kc, piv, om, cmeta,
 ):
     """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
 
-    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ, ``GG`` = D K̂⁻¹ Dᵀ for this ``h``; Writes
-    the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``.
-    ``wn`` (3, n), ``wx`` (9, m + n_h) and ``J`` (m + n_h, m + n_h) are scratch.
+    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ for this ``h``. Writes the end state, the
+    hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``. ``wn`` (4, n) and
+    ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration mass of the stuck pallets
+    (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc`` (2, n, n), ``piv`` (n,),
+    ``om`` (n_h,) and ``cmeta`` (3,) the Newton core's cache (zeros at the start of a run),
+    kept across calls.
+
+    The Newton matrix is ``J = E + R_D D K̂⁻¹ Dᵀ Z`` (diagonal ``E``, ``R_D``, ``Z``: a stuck
+    pallet's row holds ``(h/2)/m_j`` and ``2/h``; a sliding pallet's ``1`` and its friction's
+    slope; a hinge's ``1``, ``1`` and column weight ``k_t − k_i``), so by Woodbury's identity
+    each Newton step is one solve with the n × n core ``K̂ + Dᵀ Z E⁻¹ R_D D`` (the tangent
+    effective stiffness with the stuck pallets' masses): O((m + n_h) n) a step while the core's
+    factors hold (same step length, contact state and hinge branches), never a dense matrix
+    of the pallets and hinges.
 
     Every hysteresis law is piecewise linear, so once an iterate lands on the same branch (same
     tangent and intercept of every hinge) as the linearisation it came from, it solves the
@@ -104,10 +182,10 @@ def _nl_trial(
     nx = m + nh
     c1 = 4.0 / h
     c2 = 2.0 / h
-    rhs, qhat, tmp = wn[0], wn[1], wn[2]
-    dfree, b, x, zp, R, ds, y = wx[0], wx[1], wx[2], wx[3], wx[4], wx[5], wx[6]
-    kt_lin, c_lin = wx[7], wx[8]  # each hinge's branch (tangent, intercept) of the last solve
-    R2 = R.reshape((nx, 1))
+    rhs, qhat, tmp, u = wn[0], wn[1], wn[2], wn[3]
+    dfree, b, x, zp, R, g, y, Ei, Rd, sw = (wx[0], wx[1], wx[2], wx[3], wx[4], wx[5], wx[6],
+                                             wx[7], wx[8], wx[9])
+    kt_lin, c_lin = wx[10], wx[11]  # each hinge's branch (tangent, intercept) of the last solve
     _damp_mul(cd, Cq, diag, qd0, rhs)
     for i in range(n):
         rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
@@ -125,12 +203,14 @@ def _nl_trial(
         dfree[m + i] += hth0[i]
     for j in range(m):
         x[j] = lam0[j]
-    for i in range(nh):  # linear prediction with the committed corrections
+        y[j] = lam0[j]
+    for i in range(nh):
+        y[m + i] = hz[i]
+    _mv(HDt, y, u)  # linear prediction of the rotations with the committed corrections
+    for i in range(nh):
         acc = dfree[m + i]
-        for j in range(m):
-            acc -= GG[m + i, j] * lam0[j]
-        for k in range(nh):
-            acc -= GG[m + i, m + k] * hz[k]
+        for k in range(n):
+            acc -= D[m + i, k] * u[k]
         x[m + i] = acc
     smooth = False  # some sliding slider has velocity-dependent friction
     for j in range(m):
@@ -155,45 +235,58 @@ def _nl_trial(
         if done or same:
             status = 0
             break
+        # residuals: g = D K̂⁻¹ Dᵀ [λ; z]
         for j in range(m):
-            sj = b[j] + 0.5 * h * x[j] / mass[j]
-            for k in range(m):
-                sj += c2 * GG[j, k] * x[k]
-            for k in range(nh):
-                sj += c2 * GG[j, m + k] * hz[k]
+            y[j] = x[j]
+        for i in range(nh):
+            y[m + i] = hz[i]
+        _mv(HDt, y, u)
+        _mv(D, u, g)
+        fresh = False  # the core carries velocity-dependent slopes: factor it for this iterate
+        for j in range(m):
+            sj = b[j] + 0.5 * h * x[j] / mass[j] + c2 * g[j]
             s1[j] = sj
-            # ds_j / dx
-            for k in range(m):
-                ds[k] = c2 * GG[j, k]
-            ds[j] += 0.5 * h / mass[j]
-            for k in range(nh):
-                ds[m + k] = c2 * GG[j, m + k] * zp[k]
+            sw[j] = 0.0
             if stuck[j]:
                 R[j] = sj
-                for k in range(nx):
-                    J[j, k] = ds[k]
+                Ei[j] = 0.5 * h / mass[j]
+                Rd[j] = c2
             else:
                 mu, dmu = _mu_slide(mus[j], mud[j], rate[j], abs(sj))
                 R[j] = x[j] + N1[j] * sig[j] * mu
                 f = N1[j] * sig[j] * dmu * (1.0 if sj >= 0.0 else -1.0)
-                for k in range(nx):
-                    J[j, k] = f * ds[k]
-                J[j, j] += 1.0
+                Ei[j] = 1.0 + f * 0.5 * h / mass[j]
+                Rd[j] = f * c2
+                if f != 0.0:
+                    sw[j] = Rd[j] / Ei[j]
+                    fresh = True
         for i in range(nh):
-            r = x[m + i] - dfree[m + i]
-            for k in range(m):
-                r += GG[m + i, k] * x[k]
-                J[m + i, k] = GG[m + i, k]
-            for k in range(nh):
-                r += GG[m + i, m + k] * hz[k]
-                J[m + i, m + k] = GG[m + i, m + k] * zp[k]
-            J[m + i, m + i] += 1.0
-            R[m + i] = r
-        _solve_into(J, R2)  # R becomes the Newton step (negated)
+            R[m + i] = x[m + i] - dfree[m + i] + g[m + i]
+            Ei[m + i] = 1.0
+            Rd[m + i] = 1.0
+        changed = _core_weights(D[m:], zp[:nh], om, Kc, cmeta)
+        if fresh or changed or cmeta[0] != h or cmeta[2] != n_cfg:
+            ok = _core_factor(kd, cd, Cq, diag, h, Ms_key, Kc, sw[:m], D, piv)
+            cmeta[0] = h if ok and not fresh else 0.0
+            cmeta[2] = n_cfg
+            if not ok:
+                break
+        # Newton step (Woodbury): t = −E⁻¹R; Δ = t − E⁻¹ R_D D core⁻¹ Dᵀ Z t
+        for a in range(nx):
+            y[a] = -R[a] / Ei[a]
+        for k in range(n):
+            u[k] = 0.0
+        for a in range(nx):
+            za = y[a] if a < m else y[a] * zp[a - m]
+            if za != 0.0:
+                for k in range(n):
+                    u[k] += za * D[a, k]
+        _core_solve(Kc, piv, u)
+        _mv(D, u, g)
         step = 0.5 if it >= _NEWTON_DAMPED else 1.0
         conv = True
         for k in range(nx):
-            d = -step * R[k]
+            d = step * (y[k] - Rd[k] / Ei[k] * g[k])
             scale = abs(x[k]) + (1e-300 if k >= m else mus[k] * N1[k] + 1e-300)
             if abs(d) > 1e-12 * scale and abs(d) > 1e-16:
                 conv = False
@@ -206,7 +299,7 @@ def _nl_trial(
     for i in range(nh):
         y[m + i] = hz[i]
     _newmark_end(h, HDt, y, qhat, q0, qd0, qdd0, D[:m], mass, ag1, lam1, w0, wd0, wdd0, stuck,
-                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, ds)
+                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, g)
     return status
 
 

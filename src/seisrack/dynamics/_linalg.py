@@ -62,19 +62,55 @@ def _solve_into(a, x):
 
 
 @_JIT
-def _mm_pt(A, P):
-    """A @ P.T for A (k, n), P (m, n): shape (k, m)."""
-    k = A.shape[0]
-    m = P.shape[0]
-    n = P.shape[1]
-    out = np.empty((k, m))
+def _lu_into(a, piv):
+    """LU factors of ``a`` in place, partial pivoting (row ``c`` swapped with ``piv[c]``);
+    returns False when a pivot is exactly zero (singular)."""
+    k = a.shape[0]
+    for c in range(k):
+        p = c
+        big = abs(a[c, c])
+        for i in range(c + 1, k):
+            if abs(a[i, c]) > big:
+                big = abs(a[i, c])
+                p = i
+        piv[c] = p
+        if big == 0.0:
+            return False
+        if p != c:
+            for j in range(k):
+                tmp = a[c, j]
+                a[c, j] = a[p, j]
+                a[p, j] = tmp
+        d = a[c, c]
+        for i in range(c + 1, k):
+            f = a[i, c] / d
+            a[i, c] = f
+            if f != 0.0:
+                for j in range(c + 1, k):
+                    a[i, j] -= f * a[c, j]
+    return True
+
+
+@_JIT
+def _lu_solve(a, piv, x):
+    """Solve with the factors of ``_lu_into``: ``x`` (k,) is overwritten by the solution."""
+    k = a.shape[0]
+    for c in range(k):
+        p = piv[c]
+        if p != c:
+            tmp = x[c]
+            x[c] = x[p]
+            x[p] = tmp
     for i in range(k):
-        for j in range(m):
-            acc = 0.0
-            for t in range(n):
-                acc += A[i, t] * P[j, t]
-            out[i, j] = acc
-    return out
+        acc = x[i]
+        for j in range(i):
+            acc -= a[i, j] * x[j]
+        x[i] = acc
+    for i in range(k - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, k):
+            acc -= a[i, j] * x[j]
+        x[i] = acc / a[i, i]
 
 
 @_JIT

@@ -20,7 +20,7 @@ try:  # names injected by the loader when executed after ``_planar_step.py``
     _chol_solve  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT
-    from seisrack.dynamics._planar_step import _chol_solve
+    from seisrack.dynamics._lapack import _chol_solve
 
 #: block Gauss–Seidel sweeps over the released pallets
 _SWEEPS = 200

@@ -12,9 +12,9 @@ try:  # names injected by the loader when executed after ``_planar_step.py``
     _chol  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, KIND_REVERSE, KIND_SLIP, KIND_STICK
+    from seisrack.dynamics._lapack import _chol, _chol_solve
     from seisrack.dynamics._planar_contact import _released_forces
-    from seisrack.dynamics._planar_lapack import _chol
-    from seisrack.dynamics._planar_step import _chol_solve, _s_update
+    from seisrack.dynamics._planar_step import _s_update
 
 @_JIT
 def _start_values(stuck, mus, N0, S0, e_lo):

@@ -18,27 +18,10 @@ try:  # names injected by the loader when executed after ``_events.py``
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, _interp
     from seisrack.dynamics._hysteresis import _hyst_trial_at, _hyst_zwork
+    from seisrack.dynamics._lapack import _chol, _chol_solve, _syrk_lower
     from seisrack.dynamics._planar_hinges import _hinge_eval, _minus_qtz
-    from seisrack.dynamics._planar_lapack import _chol, _syrk_lower
 
 _NEWTON_MAX = 40
-
-
-@_JIT
-def _chol_solve(L, x):
-    """Solve (L Lᵀ) y = x in place."""
-    n = L.shape[0]
-    for i in range(n):
-        acc = x[i]
-        for k in range(i):
-            acc -= L[i, k] * x[k]
-        x[i] = acc / L[i, i]
-    # Lᵀ y = x by columns of Lᵀ, i.e. rows of L (contiguous)
-    for i in range(n - 1, -1, -1):
-        xi = x[i] / L[i, i]
-        x[i] = xi
-        for k in range(i):
-            x[k] -= L[i, k] * xi
 
 
 @_JIT

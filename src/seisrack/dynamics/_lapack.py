@@ -1,10 +1,12 @@
-"""In-place Cholesky factorisation of the planar kernel's Newton matrix (source shared by the
-numba and pure-Python backends; theory: ``docs/theory/planar_friction.md`` §2).
+"""In-place Cholesky factorisation for the Newton matrices of the planar kernel and of the
+line kernel with hinges (source shared by the numba and pure-Python backends; theory:
+``docs/theory/planar_friction.md`` §2, ``docs/theory/nonlinear_hinges.md``).
 
 The matrices are square, C-ordered and symmetric, and only their lower triangle is read or
-written: ``_syrk_lower`` adds GᵀG to it and ``_chol`` overwrites it with the Cholesky factor
-L (A = L Lᵀ); the strict upper triangle is left as it was. Compiled, both call LAPACK / BLAS
-directly (:mod:`seisrack.dynamics._lapack_symbols`): Fortran reads a C-ordered matrix as its
+written: ``_syrk_lower`` adds GᵀG to it, ``_chol`` overwrites it with the Cholesky factor
+L (A = L Lᵀ) and ``_chol_solve`` solves with that factor; the strict upper triangle is left as
+it was. Compiled, the first two call LAPACK / BLAS directly
+(:mod:`seisrack.dynamics._lapack_symbols`): Fortran reads a C-ordered matrix as its
 transpose, so the lower triangle here is Fortran's upper one ("U"), and the rows of G are the
 columns of a Fortran matrix X with GᵀG = X Xᵀ. Against ``np.dot(G.T, G)`` and
 ``np.linalg.cholesky`` this halves the product's work and skips three copies of the matrix.
@@ -20,7 +22,8 @@ try:  # compiled: the loader injects _JIT
 
     _COMPILED = True
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    _JIT = None  # the numpy versions below are used
+    from seisrack.dynamics._events import _JIT  # the numpy versions below are used
+
     _COMPILED = False
 
 _U = 85  # ord("U")
@@ -84,3 +87,20 @@ else:
             return False
         A[np.tril_indices(A.shape[0])] = L[np.tril_indices(A.shape[0])]
         return True
+
+
+@_JIT
+def _chol_solve(L, x):
+    """Solve (L Lᵀ) y = x in place (``L``: the lower triangle that ``_chol`` wrote)."""
+    n = L.shape[0]
+    for i in range(n):
+        acc = x[i]
+        for k in range(i):
+            acc -= L[i, k] * x[k]
+        x[i] = acc / L[i, i]
+    # Lᵀ y = x by columns of Lᵀ, i.e. rows of L (contiguous)
+    for i in range(n - 1, -1, -1):
+        xi = x[i] / L[i, i]
+        x[i] = xi
+        for k in range(i):
+            x[k] -= L[i, k] * xi

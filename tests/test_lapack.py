@@ -1,4 +1,4 @@
-"""The planar kernel's in-place Cholesky factorisation (``_planar_lapack.py``): LAPACK
+"""The planar kernel's in-place Cholesky factorisation (``_lapack.py``): LAPACK
 ``dpotrf`` and BLAS ``dsyrk`` called from compiled code, and the numpy twins of the pure-Python
 backend. Reference: numpy's ``cholesky`` and ``G.T @ G`` (LAPACK / BLAS through numpy, an
 independent call path), on the lower triangle; the strict upper triangle must stay as it was.
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from seisrack.dynamics import _planar_lapack as twin
+from seisrack.dynamics import _lapack as twin
 
 
 def _backends():
