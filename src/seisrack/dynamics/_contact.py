@@ -18,21 +18,22 @@ try:  # names injected by the loader when executed after ``_events.py`` and ``_l
     _release_worst  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     from seisrack.dynamics._events import _JIT, _apply_candidates, _release_worst
-    from seisrack.dynamics._linalg import _damp_mul, _mv
+    from seisrack.dynamics._lapack import _chol, _chol_solve
+    from seisrack.dynamics._linalg import _damp_mul, _mtv, _mv
 
 
 @_JIT
-def _newmark_end(h, HYt, y, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
+def _newmark_end(h, DH, y, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
                  q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vn):
-    """End state of an average-acceleration step of length ``h``: Δq = q̂ − HYt·y (``y``: the
-    slider forces, then any hinge corrections; ``HYt`` = K̂⁻¹ [P; Q]ᵀ), the Newmark updates of
+    """End state of an average-acceleration step of length ``h``: Δq = q̂ − (DH)ᵀ y (``y``: the
+    slider forces, then any hinge corrections; ``DH`` = [P; Q] K̂⁻¹), the Newmark updates of
     q̇, q̈, and the sliders' (w, ẇ, ẅ) under the forces ``lam1``; a stuck slider gets exactly
     its support's velocity (removes round-off drift). ``f`` (n,), ``vn`` (m,) are scratch."""
     n = q0.shape[0]
     c0 = 4.0 / (h * h)
     c1 = 4.0 / h
     c2 = 2.0 / h
-    _mv(HYt, y, f)
+    _mtv(DH, y, f)
     for i in range(n):
         dq = qhat[i] - f[i]
         q1[i] = q0[i] + dq
@@ -121,23 +122,6 @@ def _cfg_update(P, mass, stuck, on_struct, key, Ms_key, n_rank1):
 
 
 @_JIT
-def _spd_solve(A, b, x):
-    """x = A⁻¹ b for a small symmetric positive-definite A (Cholesky)."""
-    r = A.shape[0]
-    L = np.linalg.cholesky(A)
-    for i in range(r):
-        acc = b[i]
-        for k in range(i):
-            acc -= L[i, k] * x[k]
-        x[i] = acc / L[i, i]
-    for i in range(r - 1, -1, -1):
-        acc = x[i]
-        for k in range(i + 1, r):
-            acc -= L[k, i] * x[k]
-        x[i] = acc / L[i, i]
-
-
-@_JIT
 def _consistent(P, mass, mus, mud, on_struct, Ms_key, key, base, ag, N, stuck, sig, cand,
                 forced, qdd, wdd, lam):
     """Decide the contact state at an instant and compute consistent accelerations.
@@ -159,27 +143,32 @@ def _consistent(P, mass, mus, mud, on_struct, Ms_key, key, base, ag, N, stuck, s
     for j in range(m):
         if on_struct[j] and stuck[j] != key[j]:
             _rank1(Mt, P[j], mass[j] if stuck[j] else -mass[j])
+    L = np.empty((r, r))
+    f = np.empty(m)
     rhs = np.empty(r)
+    acc = np.empty(m)
     for _it in range(2 * m + 2):
-        for i in range(r):
-            rhs[i] = base[i]
         for j in range(m):
             if stuck[j]:
-                f = -mass[j] * ag
+                f[j] = mass[j] * ag
             else:
                 lam[j] = -mud[j] * N[j] * sig[j]
-                f = -lam[j]
-            if on_struct[j] and f != 0.0:
-                for i in range(r):
-                    rhs[i] += P[j, i] * f
-        _spd_solve(Mt, rhs, qdd)
+                f[j] = lam[j]
+            if not on_struct[j]:
+                f[j] = 0.0
+        _mtv(P, f, rhs)
+        for i in range(r):
+            rhs[i] = base[i] - rhs[i]
+        L[:, :] = Mt
+        if not _chol(L):  # not reached: the configuration mass is positive definite
+            lam[:] = np.nan
+            break
+        _chol_solve(L, rhs)
+        qdd[:] = rhs
+        _mv(P, qdd, acc)
         for j in range(m):
             if stuck[j]:
-                acc = 0.0
-                if on_struct[j]:
-                    for i in range(r):
-                        acc += P[j, i] * qdd[i]
-                lam[j] = mass[j] * (acc + ag)
+                lam[j] = mass[j] * ((acc[j] if on_struct[j] else 0.0) + ag)
         worst = _release_worst(stuck, forced, lam, mus, N, sig)
         if worst < 0:
             break

@@ -67,7 +67,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _mu_now,
         _nl_trial,
     )
-    from seisrack.dynamics._linalg import _damp_mul, _hmat_pt, _mv
+    from seisrack.dynamics._linalg import _damp_mul, _dh_into, _mv
 
 
 @_JIT
@@ -103,7 +103,8 @@ def run_kernel(
     D = np.empty((m + nh, n))  # [P; Q]: P alone on the linear path
     D[:m] = P
     D[m:] = Q
-    HPt_dt = _hmat_pt(kd, cd, Cq, diag, dt, D)  # operator of the regular step
+    DH = np.empty((2, m + nh, n))  # D K̂⁻¹ of the regular step, and of a shorter one
+    _dh_into(kd, cd, Cq, diag, dt, D, DH[0])
     # state at the start of the (sub)step: T0 rows q, qd, qdd; S0 rows w, wd, lam, s, wdd
     T0 = np.zeros((3, n))
     T0[0] = q_init
@@ -172,13 +173,15 @@ def run_kernel(
             for i in range(n):
                 pe1[i] = pext[step + 1, i]
             ag1 = ag[step + 1]
-            HPt = HPt_dt if full else _hmat_pt(kd, cd, Cq, diag, hrem, D)
+            if not full:
+                _dh_into(kd, cd, Cq, diag, hrem, D, DH[1])
+            DHh = DH[0] if full else DH[1]
             hz_t[:] = hz
             st_tr = _nl_trial(
-                hrem, kd, cd, Cq, diag, D, HPt, mass, mus, mud, rate, hth0, hk, hlaw, hpar,
-                hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1], stuck, sig,
-                q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key, n_cfg, Kc,
-                piv, om, cmeta)
+                hrem, kd, cd, Cq, diag, D, DHh, mass, mus, mud, rate, hth0,
+                hk, hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
+                stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
+                n_cfg, Kc, piv, om, cmeta)
             if st_tr != STATUS_OK:
                 status = st_tr
                 break
@@ -197,10 +200,10 @@ def run_kernel(
                         break
                     ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
                     hsub = th * hrem
-                    HPt = _hmat_pt(kd, cd, Cq, diag, hsub, D)
+                    _dh_into(kd, cd, Cq, diag, hsub, D, DH[1])
                     hz_t[:] = hz
                     st_tr = _nl_trial(
-                        hsub, kd, cd, Cq, diag, D, HPt, mass, mus, mud, rate, hth0, hk, hlaw,
+                        hsub, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0, hk, hlaw,
                         hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e, stuck,
                         sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
                         n_cfg, Kc, piv, om, cmeta)

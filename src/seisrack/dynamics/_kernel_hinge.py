@@ -37,7 +37,14 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
     from seisrack.dynamics._events import _JIT
     from seisrack.dynamics._hysteresis import HYST_S_THETA, _hyst_trial_at
     from seisrack.dynamics._lapack import _chol, _chol_solve
-    from seisrack.dynamics._linalg import _damp_mul, _lu_into, _lu_solve, _modal_solve, _mv
+    from seisrack.dynamics._linalg import (
+        _damp_mul,
+        _lu_into,
+        _lu_solve,
+        _modal_solve,
+        _mtv,
+        _mv,
+    )
 
 STATUS_NEWTON = 4
 _NEWTON_MAX = 60
@@ -149,13 +156,13 @@ def _core_solve(Kc, piv, x):
 
 @_JIT
 def _nl_trial(
-    h, kd, cd, Cq, diag, D, HDt, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
+    h, kd, cd, Cq, diag, D, DH, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
     q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, Ms_key, n_cfg, Kc, piv, om, cmeta,
 ):
     """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
 
-    ``D`` = [P; Q] ((m + n_h), n), ``HDt`` = K̂⁻¹ Dᵀ for this ``h``. Writes the end state, the
+    ``D`` = [P; Q] ((m + n_h), n), ``DH`` = D K̂⁻¹ for this ``h``. Writes the end state, the
     hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``. ``wn`` (4, n) and
     ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration mass of the stuck pallets
     (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc`` (2, n, n), ``piv`` (n,),
@@ -206,12 +213,10 @@ def _nl_trial(
         y[j] = lam0[j]
     for i in range(nh):
         y[m + i] = hz[i]
-    _mv(HDt, y, u)  # linear prediction of the rotations with the committed corrections
+    _mtv(DH, y, u)  # linear prediction of the rotations with the committed corrections
+    _mv(D, u, g)
     for i in range(nh):
-        acc = dfree[m + i]
-        for k in range(n):
-            acc -= D[m + i, k] * u[k]
-        x[m + i] = acc
+        x[m + i] = dfree[m + i] - g[m + i]
     smooth = False  # some sliding slider has velocity-dependent friction
     for j in range(m):
         if not stuck[j] and rate[j] > 0.0:
@@ -240,7 +245,7 @@ def _nl_trial(
             y[j] = x[j]
         for i in range(nh):
             y[m + i] = hz[i]
-        _mv(HDt, y, u)
+        _mtv(DH, y, u)
         _mv(D, u, g)
         fresh = False  # the core carries velocity-dependent slopes: factor it for this iterate
         for j in range(m):
@@ -274,13 +279,11 @@ def _nl_trial(
         # Newton step (Woodbury): t = −E⁻¹R; Δ = t − E⁻¹ R_D D core⁻¹ Dᵀ Z t
         for a in range(nx):
             y[a] = -R[a] / Ei[a]
-        for k in range(n):
-            u[k] = 0.0
-        for a in range(nx):
-            za = y[a] if a < m else y[a] * zp[a - m]
-            if za != 0.0:
-                for k in range(n):
-                    u[k] += za * D[a, k]
+        for a in range(m, nx):
+            R[a] = y[a] * zp[a - m]  # R is free now: Z t
+        for a in range(m):
+            R[a] = y[a]
+        _mtv(D, R, u)
         _core_solve(Kc, piv, u)
         _mv(D, u, g)
         step = 0.5 if it >= _NEWTON_DAMPED else 1.0
@@ -298,8 +301,8 @@ def _nl_trial(
         lam1[j] = x[j]
     for i in range(nh):
         y[m + i] = hz[i]
-    _newmark_end(h, HDt, y, qhat, q0, qd0, qdd0, D[:m], mass, ag1, lam1, w0, wd0, wdd0, stuck,
-                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, g)
+    _newmark_end(h, DH, y, qhat, q0, qd0, qdd0, D[:m], mass, ag1, lam1, w0, wd0, wdd0, stuck,
+                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, g[:m])
     return status
 
 
