@@ -181,7 +181,8 @@ def test_rack_reduced_basis_keeps_the_full_peaks():
 
 
 def test_rack_sliding_converges_with_yielding_hinges():
-    """Peak pallet sliding and peak hinge rotation against a run at dt/16: fitted order ~2."""
+    """Peak pallet sliding and peak hinge rotation against a run at dt/16: fitted order ≥ 1.8
+    (issue 22; measured 1.89 and 1.92)."""
     model = _nonlinear_rack(0.5)
     rec = _record(8.0, 2.0)
     h = rack_hinges(model)
@@ -197,7 +198,7 @@ def test_rack_sliding_converges_with_yielding_hinges():
     errs = np.array([np.abs(peaks(dt) - ref) / ref for dt in dts])
     for col in range(2):
         order = np.polyfit(np.log(dts), np.log(errs[:, col]), 1)[0]
-        assert order > 1.5, (col, order, errs[:, col])
+        assert order >= 1.8, (col, order, errs[:, col])
     assert np.all(errs[-1] < 1e-3)
 
 
