@@ -137,6 +137,21 @@ def test_chunks_do_not_change_the_held_directions(case):
     assert a.energy_error() < 1e-9
 
 
+def test_a_run_stopped_inside_a_chunk_keeps_only_computed_steps(case, monkeypatch):
+    """A run that stops (here: one sub-step allowed per step, so the first event stops it)
+    returns the steps it completed, with the held directions recovered on those rows only."""
+    from seisrack.dynamics import planar
+
+    model, motion, _ = case
+    monkeypatch.setattr(planar, "_MAX_SUBSTEPS", 1)
+    with np.errstate(all="raise"):  # no arithmetic on rows the kernel never wrote
+        resp = run_rack(model, motion, throw=False)
+    h = resp.history
+    assert h.status != "ok" and h.basis["quasi_static"] > 0
+    assert 1 < h.t.size < len(motion.x)
+    assert np.all(np.isfinite(h.q)) and np.all(np.isfinite(h.qd))
+
+
 def test_stops_close_the_energy_balance_on_a_flexible_rack():
     """The snap at a located stop is one impulsive friction contact whose reaction the
     structure and its stuck pallets take (``_planar_events._snap_stops``): the kinetic energy

@@ -154,6 +154,12 @@ def run_planar_scheme(
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
+            if status != 0:  # only the rows up to the last completed step hold a state
+                k = min(k, int(kd_done) + 1)
+                stop = start + k - 1
+                rows = slice(start, stop + 1)
+                outs = tuple(o[:k] for o in outs)
+                N = N[:k]
             if qs.count:
                 fk = tuple(f[:k] for f in full)
                 qs.fill(ser[rows], outs[5], outs[:3], fk,
