@@ -15,50 +15,19 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
 def _solve(A, B):
     """Solve A X = B by Gaussian elimination with partial pivoting; A (k, k), B (k, r).
 
-    Hand-written (instead of np.linalg) to keep numba compile times short; k is small here
-    (number of stuck sliders) or the modal size for non-classical damping only.
+    Hand-written (instead of np.linalg) to keep numba compile times short; used for the modal
+    size with non-classical damping only.
     """
+    a = A.copy()
+    piv = np.empty(a.shape[0], dtype=np.int64)
+    _lu_into(a, piv)
     x = B.copy()
-    _solve_into(A.copy(), x)
+    col = np.empty(a.shape[0])
+    for j in range(x.shape[1]):
+        col[:] = x[:, j]
+        _lu_solve(a, piv, col)
+        x[:, j] = col
     return x
-
-
-@_JIT
-def _solve_into(a, x):
-    """Solve a y = x in place (``a`` is overwritten by its factors, ``x`` (k, r) by y): no
-    allocation, for the Newton iterations of the nonlinear trial."""
-    k = a.shape[0]
-    r = x.shape[1]
-    for c in range(k):
-        piv = c
-        big = abs(a[c, c])
-        for i in range(c + 1, k):
-            if abs(a[i, c]) > big:
-                big = abs(a[i, c])
-                piv = i
-        if piv != c:
-            for j in range(k):
-                tmp = a[c, j]
-                a[c, j] = a[piv, j]
-                a[piv, j] = tmp
-            for j in range(r):
-                tmp = x[c, j]
-                x[c, j] = x[piv, j]
-                x[piv, j] = tmp
-        d = a[c, c]
-        for i in range(c + 1, k):
-            f = a[i, c] / d
-            if f != 0.0:
-                for j in range(c, k):
-                    a[i, j] -= f * a[c, j]
-                for j in range(r):
-                    x[i, j] -= f * x[c, j]
-    for c in range(k - 1, -1, -1):
-        for j in range(r):
-            acc = x[c, j]
-            for i in range(c + 1, k):
-                acc -= a[c, i] * x[i, j]
-            x[c, j] = acc / a[c, c]
 
 
 @_JIT

@@ -21,6 +21,8 @@ try:  # compiled: the loader injects _JIT
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
     import scipy.linalg
 
+    from seisrack.dynamics._lapack import _chol
+
     _JIT = None  # the numpy versions below are used
     _BLAS = False
 
@@ -91,17 +93,7 @@ else:
 
     def _potrf_corner(A, b):
         """Lower Cholesky factor of A[:b, :b] in place; False if not positive definite."""
-        if b == 0:
-            return True
-        low = np.tril(A[:b, :b])
-        try:
-            L = np.linalg.cholesky(low + np.tril(low, -1).T)
-        except np.linalg.LinAlgError:
-            return False
-        if not np.all(np.isfinite(L)):
-            return False
-        A[:b, :b] = np.where(np.tri(b, dtype=bool), L, A[:b, :b])
-        return True
+        return True if b == 0 else _chol(A[:b, :b])
 
     def _trsm_corner(L, b, X, bn):
         """X[:b, :bn] = L[:b, :b]⁻¹ X[:b, :bn] (L lower triangular)."""
