@@ -29,6 +29,13 @@ AUTO_FULL_MAX_DOF = 50
 #: (tests/test_engine_hinges.py)
 HINGE_RITZ_BLOCKS = 2
 HINGE_RITZ_TOL = 1e-3
+#: the size cap of that basis on a line (the reduced basis's default, 200, elsewhere). The line
+#: kernel's step costs O((m + n_h) r) and a factorisation O(r³) (no matrix of the sliders and
+#: hinges), so it affords the directions the hinges need: on the 2D warehouse example with every
+#: connection bilinear (400 pallets, 421 hinges) 523 vectors (static error 0.008) took 77 s of
+#: CPU for 20 s of EC8, where the cap of 200 (static error 0.94) took 8 s and was wrong: peak
+#: sliding 6.9 mm against 17.6 mm, level peaks up to 45 % off (benchmarks/nonlinear_scale.py)
+HINGE_RITZ_MAX_SIZE = 600
 
 
 def choose_basis(basis: str | Basis, M, K, sliders: Sliders | PlanarSliders,  # noqa: ANN001, N803
@@ -79,7 +86,8 @@ def _line_ritz(M, sliders: Sliders, r, rv, F, hinges):  # noqa: ANN001, ANN202, 
     opts = {}
     if hinges is not None:
         loads.append(hinges.load_vectors(n)[:, hinges.law != 0])
-        opts = {"blocks": HINGE_RITZ_BLOCKS, "tol": HINGE_RITZ_TOL}
+        opts = {"blocks": HINGE_RITZ_BLOCKS, "tol": HINGE_RITZ_TOL,
+                "max_size": HINGE_RITZ_MAX_SIZE}
     return sliders.dof, sliders.mass, np.column_stack(loads), opts
 
 
