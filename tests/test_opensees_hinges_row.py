@@ -33,7 +33,6 @@ from seisrack.model import compile_rack, load_rack, with_friction
 from seisrack.model.hinge_law import HingeLaw
 from seisrack.model.spec import Hysteresis
 from seisrack.motion import Record, generate_ec8_record
-
 from test_opensees_hinges import opensees_history, residual_drift
 
 pytestmark = pytest.mark.slow
