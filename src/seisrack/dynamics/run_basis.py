@@ -29,12 +29,14 @@ AUTO_FULL_MAX_DOF = 50
 #: (tests/test_engine_hinges.py)
 HINGE_RITZ_BLOCKS = 2
 HINGE_RITZ_TOL = 1e-3
-#: the size cap of that basis on a line (the reduced basis's default, 200, elsewhere). The line
-#: kernel's step costs O((m + n_h) r) and a factorisation O(r³) (no matrix of the sliders and
-#: hinges), so it affords the directions the hinges need: on the 2D warehouse example with every
-#: connection bilinear (400 pallets, 421 hinges) 523 vectors (static error 0.008) took 77 s of
-#: CPU for 20 s of EC8, where the cap of 200 (static error 0.94) took 8 s and was wrong: peak
-#: sliding 6.9 mm against 17.6 mm, level peaks up to 45 % off (benchmarks/nonlinear_scale.py)
+#: the size cap of that basis, on a line and in the plane (the reduced basis's default, 200,
+#: without hinges): the directions the hinges need cost r³ a factorisation, but the cap of 200
+#: gave wrong answers. 2D warehouse example, every connection bilinear (400 pallets, 421
+#: hinges), 20 s of EC8: 523 vectors (static error 0.008) in 77 s of CPU, where 200 (static
+#: error 0.94) took 8 s with peak sliding 6.9 mm against 17.6 mm and level peaks up to 45 % off.
+#: 3D 5 x 10 example, bilinear: 398 vectors (0.0046) in 28 s against 200 (0.78) in 8.6 s, level
+#: peaks down-aisle up to 100 % off; 3D 10 x 5 example: 433 vectors in 224 s, peak sliding
+#: 158.4 mm against 144.7 mm (benchmarks/results/nonlinear_scale.md)
 HINGE_RITZ_MAX_SIZE = 600
 
 
@@ -115,7 +117,8 @@ def _planar_ritz(M, sliders: PlanarSliders, influence, rv, hinges):  # noqa: ANN
     opts = {"tol": PLANAR_RITZ_TOL, "target_size": PLANAR_RITZ_TARGET}
     if hinges is not None:
         loads.append(hinges.load_vectors(n)[:, hinges.law != 0])
-        opts = {"tol": PLANAR_HINGE_RITZ_TOL, "target_size": PLANAR_HINGE_RITZ_TARGET}
+        opts = {"tol": PLANAR_HINGE_RITZ_TOL, "target_size": PLANAR_HINGE_RITZ_TARGET,
+                "max_size": HINGE_RITZ_MAX_SIZE}
     return (*_planar_patterns(sliders, n, np.column_stack(loads) if loads
                               else np.ones((n, 1))), {**opts, "unit_loads": False})
 
