@@ -120,7 +120,7 @@ def run_kernel(
     wn = np.empty((4, n))  # scratch of the trial step, and its Newton core's cache
     wx = np.empty((12, m + nh))
     Kc = np.zeros((2, n, n))
-    piv = np.zeros(n, dtype=np.int64)
+    piv = np.zeros(max(n, 1), dtype=np.int64)  # piv[0] also marks a Cholesky factor
     om = np.zeros(nh)
     cmeta = np.zeros(3)
     _hinge_state(Q, hth0, hk, hlaw, hpar, hst, q, hst_t, hM, hz)
