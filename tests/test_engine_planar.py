@@ -212,6 +212,42 @@ def test_one_axis_on_a_structure_equals_the_1d_engine():
     assert [(e.slider, e.kind) for e in hp.events] == [(e.slider, e.kind) for e in h1.events]
 
 
+@pytest.mark.parametrize("mus", [0.0, 0.3])
+def test_no_dynamic_friction_equals_the_1d_engine(mus):
+    """mu_d = 0 (allowed: friction >= 0) once made the plane's contact solve divide by a zero
+    disc radius (a non-finite response). Along one axis it is the 1D engine's answer; with
+    mu_s = 0 too, a pallet feels no force at all and keeps its absolute position."""
+    M, C, K = _frame()
+    dt = 0.005
+    t = np.arange(0, 8 + dt / 2, dt)
+    # two frequencies: under one sine a pallet sliding without friction stops exactly where
+    # |a_g| = mu_s g again (by symmetry), a grazing decision either engine may take either way
+    ag = (5.0 * np.sin(2 * np.pi * 1.1 * t) + 2.0 * np.sin(2 * np.pi * 2.7 * t + 0.5)) * np.exp(
+        -0.2 * t)
+    mass, mud, dofx, dofz = [400.0, 300.0, 500.0], [0.0, 0.25, 0.0], [0, 1, 1], [2, 3, 3]
+    mu_s = [mus, max(mus, 0.25), mus]
+    hp = _run_planar(M, C, K, PlanarSliders(dofx, dofz, mass, mu_s, mud), dt=dt,
+                     ground_x=ag, influence_x=[1, 1, 0, 0], basis="full")
+    h1 = simulate(M[:2, :2], C[:2, :2], K[:2, :2], Sliders(dofx, mass, mu_s, mud), dt=dt,
+                  ground_accel=ag, method="newmark", basis="full")
+    assert np.all(np.isfinite(hp.sliding))
+    peak = np.abs(h1.sliding).max()
+    assert peak > 0.01
+    # measured 1.6e-8 of the peak (mu_s 0.3), 0 (mu_s 0): the event tolerances differ
+    assert np.abs(hp.sliding[:, :, 0] - h1.sliding).max() < 1e-7 * peak
+    assert np.abs(hp.sliding[:, :, 1]).max() == 0.0
+    if mus == 0.0:
+        # no force on pallets 1 and 3: their displacement relative to the ground is minus
+        # the ground's (Newmark's trapezoidal velocity is exact for a linear ground
+        # acceleration, its displacement within O(dt^2))
+        assert np.abs(hp.friction[:, [0, 2]]).max() == 0.0
+        vg = np.concatenate([[0.0], np.cumsum(0.5 * dt * (ag[1:] + ag[:-1]))])
+        dg = np.concatenate([[0.0], np.cumsum(0.5 * dt * (vg[1:] + vg[:-1]))])
+        u_sup = hp.u[:, dofx]  # the supports' displacement relative to the ground
+        w = hp.sliding[:, :, 0] + u_sup
+        assert np.abs(w[:, [0, 2]] + dg[:, None]).max() < 1e-3 * np.abs(dg).max()
+
+
 def test_friction_law_in_the_plane():
     M, C, K = _frame()
     dt = 0.002

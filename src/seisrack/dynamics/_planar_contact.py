@@ -35,6 +35,8 @@ def _disc_min(w11, w12, w22, c1, c2, f):
     l2 = -(w11 * c2 - w12 * c1) / det
     if l1 * l1 + l2 * l2 <= f * f:
         return l1, l2, True
+    if f <= 0.0:  # no friction (mu_d = 0, or no contact force): the disc is a point
+        return 0.0, 0.0, False
     # on the circle: lam = -(W + nu I)^-1 c with |lam| = f, nu > 0; in the eigenvectors of W
     # |lam(nu)|² = Σ d_i² / (w_i + nu)², decreasing in nu
     if w12 == 0.0:
