@@ -29,7 +29,7 @@ from seisrack.dynamics import PlanarSliders
 from seisrack.dynamics.local import LocalSliders
 from seisrack.dynamics.local.engine import memory_estimate, simulate_local
 from seisrack.dynamics.reference import simulate_reference
-from seisrack.errors import InputError
+from seisrack.errors import InputError, SolverError
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_engine_planar import (  # noqa: E402
@@ -174,6 +174,16 @@ def test_bad_input():
         simulate_local(M2, C2, K2, LocalSliders(np.array([[[0], [1]]]), 100.0, 0.3), dt=0.01,
                        ground=t[:, None], influence=np.ones((1, 2)), slices=[0, 1])
     assert exc.value.field == "sliders.support[0]"
+
+
+def test_a_response_that_overflows_is_an_error_not_a_result():
+    """Only the first coordinate was checked for finiteness: a ground motion of 1e300 m/s²
+    overflowed the pallets' forces and the other coordinates, and the run ended "ok" with
+    zero sliding. Every coordinate and force is checked now."""
+    t = np.arange(0, 1.0 + 0.005 / 2, 0.005)
+    with pytest.raises(SolverError, match="non-finite"):
+        simulate_local(M2, C2, K2, LocalSliders(DOF, MASS, MU_S, MU_D), dt=0.005,
+                       ground=1e300 * _ag(t)[:, None], influence=np.ones((1, 2)), tol=1e-6)
 
 
 def test_a_run_too_large_is_refused_before_allocating():

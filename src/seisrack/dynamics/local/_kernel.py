@@ -690,14 +690,19 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
         energy[0] += e_in
         energy[1] += e_damp
         energy[2] += e_fr
+        fin = 0.0  # every coordinate and the pallets' forces: a NaN anywhere shows in the sum
         for i in range(N):
             q[i] += h * vbar[i]
             v[i] += dv[i]
             dvp[i] = dv[i]
+            fin += q[i] + v[i]
+        for j in range(lam.shape[0]):
+            for c in range(lam.shape[1]):
+                fin += lam[j, c]
         _write(k + 1, q, v, uu, sv, lam, stuck, energy, Md, Mo, Kd, Ko, sizes, offsets, P,
                ps, nd, mass, tmp, out_q, out_v, out_u, out_s, out_lam, out_stuck, out_e)
         k_done = k + 1
-        if N > 0 and not (np.isfinite(q[0]) and np.isfinite(v[0])):
+        if not np.isfinite(fin):
             status = STATUS_NONFINITE
             break
     if n_ev > max_events and status == STATUS_OK:
