@@ -1,13 +1,14 @@
 """Run a study: expand, skip what is stored, execute in batches, append to the store.
 
 :func:`run_study` is the driver. It expands the study (all input errors are raised here, before
-any run), writes ``study.json``, reads the run ids already in the store and runs only the
-others, in batches (:data:`DEFAULT_BATCH` runs per task, fewer when there are few runs, so that
-every worker gets work). Rows come back as batches finish and wait in a buffer of at most
-``flush_rows`` rows (or ``flush_seconds`` seconds) before being written as one Parquet part
-file: the driver's memory does not grow with the study. On Ctrl-C the buffer is flushed before
-the interrupt propagates; a driver killed outright loses at most its buffer, which a resumed run
-recomputes.
+any run), sets aside unreadable part files, writes ``study.json`` (refused when the folder
+holds another study: :func:`~seisrack.studies.store.check_extends`), reads the run ids already
+in the store and runs only the others, in batches (:data:`DEFAULT_BATCH` runs per task, fewer
+when there are few runs, so that every worker gets work). Rows come back as batches finish and
+wait in a buffer of at most ``flush_rows`` rows (or ``flush_seconds`` seconds) before being
+written as one Parquet part file: the driver's memory does not grow with the study. On Ctrl-C
+the buffer is flushed before the interrupt propagates; a driver killed outright loses at most
+its buffer, which a resumed run recomputes.
 
 IDA with a stop rule: batches hold whole IDA curves (the worker runs a curve's levels in order
 and skips those above the level where the rule holds); the rows of one batch are written in
@@ -148,11 +149,11 @@ def run_study(spec: StudySpec | StudyPlan, out_dir: str | Path, *, executor: str
     t0 = time.perf_counter()
     pl = spec if isinstance(spec, StudyPlan) else plan(spec)
     out = Path(out_dir)
-    if isinstance(spec, StudySpec):
-        write_study_json(out, spec, pl.runs)
     aside = check_parts(out)  # a damaged or foreign part never stops a resume
     for a in aside:
         log.warning("%s; they are run again", a.message())
+    if isinstance(spec, StudySpec):  # refuses a study that does not extend the stored one
+        write_study_json(out, spec, pl.runs)
     rule = pl.ida_stop
     pre_skipped: list[dict] = []
     if rule is None:

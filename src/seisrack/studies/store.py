@@ -24,6 +24,12 @@ first). Readers that meet such a file later set it aside the same way and raise
 between writing a part and noticing it, counts once) and sorts by ``run_id``. A run stored both
 as "skipped" (an IDA level above a stop rule's level) and as run (the rule was changed or
 removed, and the level run on resume) is returned as run.
+
+One folder holds one study. ``study.json`` is valid JSON (a value that does not exist, such as
+``period_s`` of a PGA study, is ``null``; files written before held ``NaN``, which
+:func:`read_study_json` still reads). :func:`write_study_json` refuses a study that does not
+extend the one stored (:func:`check_extends`): its stored runs would otherwise be left without
+their definition and mixed with the new study's.
 """
 
 from __future__ import annotations
@@ -37,7 +43,8 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.atomic import atomic_write, write_text
-from seisrack.errors import SeisrackError
+from seisrack.errors import InputError, SeisrackError
+from seisrack.jsonable import to_jsonable
 
 #: row columns in order: (name, pyarrow type name)
 COLUMNS = (
@@ -247,11 +254,83 @@ def read_runs(out_dir: str | Path, columns: list[str] | None = None):  # noqa: A
     return table
 
 
+def read_study_json(out_dir: str | Path) -> dict[str, Any] | None:
+    """The document of ``out_dir/study.json``, or None when it is absent or unreadable.
+
+    Accepts files written before ``null`` replaced ``NaN`` (Python's parser reads both).
+    """
+    try:
+        doc = json.loads((Path(out_dir) / STUDY_JSON).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) else None
+
+
+def planned_stripes(doc: dict[str, Any] | None) -> dict[str, int] | None:
+    """``run_id`` -> stripe index (-1 for IDA) of the run table of a ``study.json`` document;
+    None when there is no run table (no file, an unreadable or hand-written one)."""
+    try:
+        return {str(r["run_id"]): int(r["stripe"]) for r in doc["runs"]} or None
+    except (TypeError, KeyError, ValueError):
+        return None
+
+
+def check_extends(out_dir: str | Path, runs: Iterable, *, source: str | None = None) -> None:
+    """Refuse (:class:`InputError` naming ``--out``) to write a study of ``runs`` into
+    ``out_dir`` when a run stored there for the study of its ``study.json`` is not one of
+    ``runs``: the same study (a resume) and an extension (more stripes, records, friction
+    samples: every stored run keeps its inputs) pass; a changed one (another stripe level,
+    record, friction, rack or step) would leave those runs without their definition and mix
+    the two studies. Checked before anything is written or run.
+    """
+    out = Path(out_dir)
+    stored = stored_run_ids(out)
+    if not stored:
+        return
+    doc = read_study_json(out)
+    planned = planned_stripes(doc)
+    # runs its study.json does not list (a folder mixed before this check) are not its own
+    ours = stored if planned is None else stored & planned.keys()
+    lost = sorted(ours - {r.run_id for r in runs})
+    if not lost:
+        return
+    owner = "another study"
+    if planned is not None:
+        owner = f"the study of {out / STUDY_JSON}" + (f" ({doc['source']})"
+                                                      if doc.get("source") else "")
+    raise InputError(
+        "--out", str(out), "a new folder, or the folder of this study or of a study it "
+        "extends (the same runs plus more stripes, records or friction samples)",
+        source=source,
+        hint=f"{len(lost)} of the {len(ours)} runs stored there belong to {owner} and are "
+             f"not runs of this one (e.g. {_describe(out, lost[0])}): running it there would "
+             "replace that definition and mix the two studies in the summary. Choose a new "
+             f"folder for --out, or move {out} away; nothing was run or written")
+
+
+def _describe(out: Path, run_id: str) -> str:
+    """One stored run in words: its rack, record, intensity and stripe."""
+    import pyarrow.compute as pc
+
+    cols = ["rack", "record", "im_measure", "im_target", "stripe"]
+    t = read_runs(out, columns=cols)
+    row = t.filter(pc.equal(t.column("run_id"), run_id)).to_pylist()[0]
+    where = f"stripe {row['stripe']}" if row["stripe"] >= 0 else "IDA"
+    return (f"run {run_id}: rack {row['rack']}, record {row['record']}, "
+            f"{row['im_measure']} = {row['im_target']:.4g} m/s², {where}")
+
+
 def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa: ANN001
-    """``study.json``: the study file as given, the resolved inputs and the run table."""
+    """``study.json``: the study file as given, the resolved inputs and the run table.
+
+    Refuses a study that does not extend the one stored in ``out_dir`` (:func:`check_extends`).
+    Non-finite values (``period_s`` of a PGA run) are written as ``null``.
+    """
     from dataclasses import asdict
 
+    runs = list(runs)
     out = Path(out_dir)
+    check_extends(out, runs, source=spec.source)
     out.mkdir(parents=True, exist_ok=True)
     doc = {
         "format": "seisrack-study/1",
@@ -277,4 +356,5 @@ def write_study_json(out_dir: str | Path, spec, runs: Iterable) -> Path:  # noqa
                                         "angle_deg": -float(r.orientation_deg) + 0.0,
                                         "n_pallets": r.n_pallets, "three_d": r.three_d}
                                        for r in wh.rows]}
-    return write_text(out / STUDY_JSON, json.dumps(doc, indent=1, allow_nan=True))
+    return write_text(out / STUDY_JSON,
+                      json.dumps(to_jsonable(doc), indent=1, allow_nan=False))

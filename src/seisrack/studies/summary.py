@@ -21,6 +21,11 @@ runs are counted with their reasons.
   (the linear crossing towards an infinite response); ``stopped_im`` gives that level.
 
 Theta is in the units of the intensity measure as stored: m/s² for both PGA and Sa.
+
+Only the runs of the study that ``study.json`` describes enter, with its stripe indices: runs
+stored in the folder for another definition of the study (an older store, where a changed
+study could be run into the same folder) are left out and counted in ``runs_left_out``, with a
+warning. Without a run table in ``study.json`` every stored run enters.
 """
 
 from __future__ import annotations
@@ -256,7 +261,7 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
         raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
     if shear_capacity is not None and not (shear_capacity > 0):
         raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
-    from seisrack.studies.store import StoreError, check_parts
+    from seisrack.studies.store import StoreError, check_parts, planned_stripes, read_study_json
 
     aside = check_parts(out)
     if aside:
@@ -267,7 +272,13 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     if table.num_rows == 0:
         raise InputError("DIR", str(out), "a study folder with stored runs (runs/part-*.parquet)",
                          hint="The study has no finished run yet; run or resume it first")
-    r = runs_as_arrays(table)
+    planned = planned_stripes(read_study_json(out))
+    r, n_other = _of_this_study(runs_as_arrays(table), planned)
+    if r["run_id"].size == 0:
+        raise InputError("DIR", str(out), "a study folder with stored runs of the study its "
+                         "study.json describes", hint=f"Its {n_other} stored runs belong to "
+                         "another definition of the study; run the study of study.json "
+                         f"(seisrack study STUDY.toml --out {out}) first")
     curve = None
     if hazard is not None:  # checked before any fit
         from seisrack.studies.risk import load_hazard_curve
@@ -281,12 +292,14 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
                       for e in r["error"][failed])
     summary: dict[str, Any] = {
         "out_dir": str(out), "runs_total": int(status.size),
-        "runs_ok": int((status == "ok").sum()),
+        "runs_ok": int((status == "ok").sum()), "runs_left_out": n_other,
         "runs_failed": int(failed.sum()), "runs_skipped": int((status == "skipped").sum()),
         "failure_reasons": dict(reasons.most_common()),
         "d_slide_m": list(d_slide), "shear_capacity_N": shear_capacity, "n_boot": int(n_boot),
         "im_units": "m/s^2", "damage_states": [s[0] for s in states], "groups": [],
-        "fragility": [], "warnings": _missing_runs(out, int(status.size)),
+        "fragility": [],
+        "warnings": _left_out(out, n_other, int(status.size))
+        + _missing_runs(out, int(status.size), planned),
     }
     groups = sorted({(a, b) for a, b in zip(r["rack"], r["im_measure"], strict=True)})
     boot_store = []
@@ -340,15 +353,37 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     return summary
 
 
-def _missing_runs(out: Path, n_stored: int) -> list[str]:
+def _of_this_study(r: dict[str, np.ndarray], planned: dict[str, int] | None
+                   ) -> tuple[dict[str, np.ndarray], int]:
+    """(the run arrays of the runs ``planned`` lists, with its stripe indices; the number of
+    stored runs left out). ``planned``: run id -> stripe of ``study.json``; None keeps all.
+
+    A stored run's own ``stripe`` is the index it had when it ran: a stripe inserted below it
+    since then shifts the study's indices, so the study's are used.
+    """
+    if planned is None:
+        return r, 0
+    keep = np.fromiter((i in planned for i in r["run_id"]), dtype=bool, count=r["run_id"].size)
+    r = {k: v[keep] for k, v in r.items()}
+    r["stripe"] = np.array([planned[i] for i in r["run_id"]], dtype=float)
+    return r, int(keep.size - keep.sum())
+
+
+def _left_out(out: Path, n_other: int, n_kept: int) -> list[str]:
+    """A warning when stored runs were left out as runs of another definition of the study."""
+    if not n_other:
+        return []
+    return [f"{n_other} stored runs are left out: they are not runs of the study that "
+            f"{out / 'study.json'} describes (another definition of the study was run into "
+            f"this folder); the statistics describe its {n_kept} runs only"]
+
+
+def _missing_runs(out: Path, n_stored: int, planned: dict[str, int] | None) -> list[str]:
     """A warning when the store holds fewer runs than ``study.json`` lists (an interrupted
     study, or part files set aside): the statistics then describe part of the study."""
-    try:
-        n_planned = len(json.loads((out / "study.json").read_text(encoding="utf-8"))["runs"])
-    except (OSError, ValueError, KeyError, TypeError):
+    if planned is None or n_stored >= len(planned):
         return []
-    if n_stored >= n_planned:
-        return []
+    n_planned = len(planned)
     return [f"the store holds {n_stored} of the study's {n_planned} runs: the statistics "
             f"describe part of the study; run it again (seisrack study STUDY.toml --out "
             f"{out}) to complete it"]
