@@ -158,3 +158,9 @@ def test_filtered_acceleration_reported_and_independent_of_save_every():
                                pk["per_level"]["beam_acceleration_filtered_m_s2"])
     with pytest.raises(ValueError, match="accel_filter_hz"):
         run_rack(model, short_record(), accel_filter_hz=0.0)
+    # below the lowest cut-off: refused by name (1e-7 Hz once ended in a LinAlgError of the
+    # filter's design); the lowest one runs
+    with pytest.raises(ValueError, match="accel_filter_hz.*>= 0.1 Hz"):
+        run_rack(model, short_record(), accel_filter_hz=1e-7)
+    assert run_rack(model, short_record(), accel_filter_hz=0.1).peaks()[
+        "acceleration_filter_hz"] == 0.1

@@ -232,6 +232,13 @@ def test_motion_or_builtin_required(capsys):
     assert exc.value.code == 2
 
 
+def test_a_filter_below_its_lowest_cut_off_is_refused(capsys, rec_csv):
+    assert main(["run", str(PAPER_RACK), "--motion", str(rec_csv), "--accel-filter", "1e-7",
+                 "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == "--accel-filter" and ">= 0.1 Hz" in err["allowed"]
+
+
 def test_subprocess_json_and_error(rec_csv, tmp_path: Path):
     def run(*args: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run([sys.executable, "-m", "seisrack", "run", str(PAPER_RACK), *args],

@@ -38,6 +38,7 @@ from seisrack.analysis.prepare import (  # noqa: F401  (RIGID_MU re-exported)
 )
 from seisrack.analysis.response import (  # noqa: F401  (re-exported: the rack API)
     ACCEL_FILTER_HZ,
+    ACCEL_FILTER_MIN_HZ,
     SLIDING_TOL_M,
     RackResponse,
 )
@@ -139,8 +140,9 @@ def run_rack(
         :mod:`seisrack.analysis.engines`).
     """
     if not (isinstance(accel_filter_hz, int | float) and math.isfinite(accel_filter_hz)
-            and accel_filter_hz > 0):
-        raise InputError("accel_filter_hz", accel_filter_hz, "a frequency > 0 Hz")
+            and accel_filter_hz >= ACCEL_FILTER_MIN_HZ):
+        raise InputError("accel_filter_hz", accel_filter_hz,
+                         f"a frequency >= {ACCEL_FILTER_MIN_HZ:g} Hz")
     if not (isinstance(free_vibration, int | float) and math.isfinite(free_vibration)
             and free_vibration >= 0):
         raise InputError("free_vibration", free_vibration, "a duration >= 0 s")

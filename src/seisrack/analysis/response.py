@@ -24,6 +24,10 @@ SLIDING_TOL_M = 1e-6
 #: (0.5-10 Hz), below the pallets' local axial beam modes (100-130 Hz) and below the Nyquist
 #: frequency of records sampled at 50 Hz
 ACCEL_FILTER_HZ = 20.0
+#: [Hz] lowest cut-off accepted: below it the filter would take away the sway modes themselves
+#: (the first periods of racks stay under 10 s), and far below (about 1e-7 Hz at dt 5 ms) the
+#: Butterworth filter's initial state cannot be computed (a singular system)
+ACCEL_FILTER_MIN_HZ = 0.1
 #: the histories that have a direction (a trailing axis on a 3D rack)
 DIRECTIONAL = ("ground_accel", "beam_displacement", "beam_acceleration", "beam_acceleration_raw",
                "beam_acceleration_filtered", "contact_force", "base_shear",

@@ -85,7 +85,7 @@ def register(subparsers: Any) -> None:
                    help="overwrite figures that already exist in --out DIR")
     p.add_argument("--accel-filter", type=float, default=None, metavar="HZ",
                    help="[Hz] cut-off of the low-pass filter of the reported floor "
-                        "accelerations (default 20; the raw peak is reported too)")
+                        "accelerations (default 20, at least 0.1; the raw peak is reported too)")
     p.add_argument("--json", action="store_true",
                    help="print one JSON object (the summary) instead of the text report")
     _register_scaling(p)
@@ -132,8 +132,11 @@ def _check_options(args: argparse.Namespace) -> None:
     if args.plot and not args.out:
         raise InputError("--plot", True, "used together with --out DIR (figures go there)")
     if args.accel_filter is not None:
-        _check_number("--accel-filter", args.accel_filter, "a frequency > 0 Hz",
-                      args.accel_filter > 0)
+        from seisrack.analysis.response import ACCEL_FILTER_MIN_HZ
+
+        _check_number("--accel-filter", args.accel_filter,
+                      f"a frequency >= {ACCEL_FILTER_MIN_HZ:g} Hz (the low-pass keeps the "
+                      "sway modes)", args.accel_filter >= ACCEL_FILTER_MIN_HZ)
 
 
 def _result_warnings(resp: Any, model: Any) -> None:
