@@ -136,6 +136,18 @@ def test_self_contained_with_every_section(study):
     assert "5-95 % bootstrap band" in text  # the bands of the stripes' fits are drawn
 
 
+def test_the_summary_warnings_are_read_first(study):
+    """Runs left out of the statistics (stored for another definition of the study, or
+    missing from the store) are said before the first section, as in the summary's text."""
+    from seisrack.report.html.study_page import build_study_html
+
+    assert 'id="warnings"' not in study["text"]  # a complete study: nothing to say
+    note = "3 stored runs are left out: they are not runs of the study"
+    text = build_study_html(dict(study["summary"], warnings=[note]))
+    assert text.index('id="warnings"') < text.index('<section id="inputs">')
+    assert html.unescape(text).count(note) == 1
+
+
 def test_inputs_name_the_study(study):
     text = html.unescape(study["text"])
     inputs = text.split('<section id="runs">')[0]

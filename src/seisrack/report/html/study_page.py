@@ -368,7 +368,19 @@ def build_study_html(summary: dict[str, Any], *, study: dict[str, Any] | None = 
             f"<title>seisrack study report: {esc(title)}</title>"
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<style>{CSS}</style></head><body><h1>Study: {esc(title)}</h1>"
-            f'<p class="summary-line">{esc(line)}</p>' + "".join(sec) + "</body></html>\n")
+            f'<p class="summary-line">{esc(line)}</p>' + _warnings(summary) + "".join(sec)
+            + "</body></html>\n")
+
+
+def _warnings(summary: dict[str, Any]) -> str:
+    """The summary's warnings (runs missing from the store, stored runs of another definition
+    of the study left out), before any figure: the statistics describe only part of what the
+    folder holds."""
+    ws = [w for w in summary.get("warnings") or [] if isinstance(w, str)]
+    if not ws:
+        return ""
+    items = "".join(f"<li>{esc(w)}</li>" for w in ws)
+    return f'<div class="disagree" id="warnings"><b>Read first:</b><ul>{items}</ul></div>'
 
 
 def write_study_report(path: str | os.PathLike[str], summary: dict[str, Any], *,
