@@ -323,3 +323,122 @@ def test_cli_bad_rows_is_one_json_error(tmp_path, capsys):
     assert main(["modal", str(f)]) == 2
     text = capsys.readouterr().err
     assert "geometry.rows" in text and "Traceback" not in text
+
+
+# --- spacer bounds (a 1 nm spacer, 1 mm spacing or spacers 0.1 mm apart once gave errors
+# naming 'C' or 'bracing.pattern' after a long build; bounds in docs/user/rack_toml.md) ------------
+
+def _small_b2b(**spacer) -> dict:
+    """``examples/warehouse_rack_3d_b2b.toml`` cut to 2 bays x 2 levels (uprights 3 m, panel
+    points and storey divisions every 0.75 m), with ``spacer`` replacing spacer keys (a value
+    None removes the key)."""
+    d = tomllib.loads(B2B.read_text())
+    d["geometry"].update(bays={"count": 2, "pitch": 2.7}, levels={"count": 2, "pitch": 1.5})
+    sp = d["geometry"]["row_spacer"]
+    for key, value in spacer.items():
+        if value is None:
+            sp.pop(key, None)
+        else:
+            sp[key] = value
+    return d
+
+
+@pytest.mark.parametrize(("spacer", "field", "words"), [
+    ({"spacing": 0.001}, "geometry.row_spacer.spacing", ">= 0.05 m"),  # 3,000 per line
+    ({"length": 1e-9}, "geometry.row_spacer.length", ">= 0.05 m"),
+    ({"spacing": None, "heights": [1.5, 1.5001]}, "geometry.row_spacer.heights[1]",
+     "at least 0.05 m above the spacer before it"),
+])
+def test_reported_spacers_refused_naming_the_key(spacer, field, words):
+    with pytest.raises(InputError) as err:
+        rack_from_dict(_small_b2b(**spacer))
+    assert err.value.field == field and words in str(err.value)
+    assert "bracing" not in str(err.value) and "'C'" not in str(err.value)
+
+
+def test_reported_spacing_refused_at_once_by_the_cli(tmp_path, capsys):
+    """The reported command: the error is one JSON paragraph, before any building."""
+    f = tmp_path / "rack.toml"
+    text = B2B.read_text().replace("count = 10, pitch = 2.7", "count = 2, pitch = 2.7")
+    f.write_text(text.replace("count = 5, pitch = 1.5", "count = 2, pitch = 1.5")
+                 .replace("spacing = 1.5      #", "spacing = 0.001    #"))
+    rec = str(EXAMPLES / "record.csv")
+    assert main(["run", str(f), "--motion", rec, "--motion-cross", rec, "--json",
+                 "--out", str(tmp_path / "out")]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == "geometry.row_spacer.spacing" and err["value"] == 0.001
+    assert "3,000 spacers" in err["message"]
+
+
+@pytest.mark.parametrize(("spacer", "field", "words"), [
+    ({"length": 0.0499}, "geometry.row_spacer.length", ">= 0.05 m"),
+    ({"spacing": 0.0499}, "geometry.row_spacer.spacing", ">= 0.05 m"),
+    # 0.7501 m: 0.1 mm from the panel point at 0.75 m
+    ({"spacing": 0.7501}, "geometry.row_spacer.spacing", "bracing member's end (0.75 m)"),
+    # 2.98 m and the spacer added at the top, 3 m
+    ({"spacing": 1.49}, "geometry.row_spacer.spacing", "at the top of the uprights (3 m)"),
+    ({"spacing": None, "heights": [1.5, 1.5499]}, "geometry.row_spacer.heights[1]",
+     "above the spacer before it"),
+    ({"spacing": None, "heights": [0.0499, 1.5]}, "geometry.row_spacer.heights[0]",
+     "above the base"),
+    ({"spacing": None, "heights": [1e-7, 1.5]}, "geometry.row_spacer.heights[0]",
+     "above the base"),
+    ({"spacing": None, "heights": [0.7999, 1.5]}, "geometry.row_spacer.heights[0]",
+     "bracing member's end (0.75 m)"),
+    ({"spacing": None, "heights": [1.5, 2.9501]}, "geometry.row_spacer.heights[1]",
+     "beam level 2 (3 m)"),
+    ({"spacing": None, "heights": list(np.arange(1, 1002) * 0.002)},
+     "geometry.row_spacer.heights", "at most 1,000"),
+])
+def test_spacers_too_short_or_too_close(spacer, field, words):
+    with pytest.raises(InputError) as err:
+        rack_from_dict(_small_b2b(**spacer))
+    assert err.value.field == field and words in str(err.value), str(err.value)
+
+
+def test_spacer_near_a_storey_division():
+    """Divisions are mesh nodes: 0.05 m from them, or a quarter of a division if less."""
+    d = _small_b2b(spacing=None, heights=[1.2, 3.0])  # 1.2 m: 0.075 from the division at 1.125
+    d["geometry"]["subdivisions"] = 8  # divisions 0.1875 m apart; the panel points stay 0.75 m
+    rack_from_dict(d)
+    d["geometry"]["row_spacer"]["heights"] = [1.16, 3.0]  # 0.035 m from 1.125
+    with pytest.raises(InputError) as err:
+        rack_from_dict(d)
+    assert err.value.field == "geometry.row_spacer.heights[0]"
+    assert "geometry.subdivisions = 8 (1.125 m)" in str(err.value)
+    d["geometry"]["subdivisions"] = 100  # 0.015 m divisions: 3.75 mm suffice off the joints
+    d["geometry"]["row_spacer"]["heights"] = [1.104, 3.0]  # 1.104: 0.006 m from 1.11
+    rack_from_dict(d)
+    d["geometry"]["row_spacer"]["heights"] = [1.1065, 3.0]  # 0.0035 m from 1.11
+    with pytest.raises(InputError) as err:
+        rack_from_dict(d)
+    assert "at least 0.00375 m" in str(err.value)
+
+
+@pytest.mark.parametrize("spacer", [
+    {"length": 0.05},
+    {"spacing": 0.05},  # 60 spacers on each line, on the 0.75 m nodes or 0.05 m from them
+    {"spacing": None, "heights": [1.5, 1.55]},
+    {"spacing": None, "heights": [0.05, 0.8, 1.45, 3.0]},  # 0.05 m from the base and nodes
+])
+def test_spacers_at_the_bounds_accepted_and_stable(spacer):
+    """At the bounds the rack builds and is stable, its first periods near those of the cut
+    rack with its spacers 0.3 m long at the beam levels (0.568 s; measured within 0.5 %)."""
+    d = _small_b2b(**spacer)
+    if "length" in spacer:  # a 0.05 m flue: overhangs of 0.02 m into it (0.04 m in all)
+        d["loading"]["overhang"], d["loading"]["depth"] = 0.02, 1.14
+    T = modal_analysis(compile_rack(rack_from_dict(d)), 3).periods
+    T_ref = modal_analysis(compile_rack(rack_from_dict(_small_b2b())), 3).periods
+    np.testing.assert_allclose(T, T_ref, rtol=0.01)
+
+
+def test_spacers_that_alone_make_the_rack_too_large():
+    """Spacers off the upright nodes add a node on every upright: counted before building."""
+    d = tomllib.loads(B2B.read_text())
+    d["geometry"].update(bays={"count": 30, "pitch": 2.7}, levels={"count": 27, "pitch": 1.5})
+    rack_from_dict(d)  # spacing 1.5: on the beam levels
+    d["geometry"]["row_spacer"]["spacing"] = 0.05  # 810 spacers per line
+    with pytest.raises(InputError) as err:
+        rack_from_dict(d)
+    assert err.value.field == "geometry.row_spacer.spacing"
+    assert "300,000 degrees of freedom" in str(err.value)

@@ -146,7 +146,8 @@ def rack_size(n_bays: int, n_levels: int, subdivisions: int, n_pallets: int, *,
     ``subdivisions - 1`` inner nodes and its two end rotations, each pallet off a station one
     node. 3D: 6 DOFs per node, a front and a rear frame, upright nodes at the union of the
     subdivision and the panel heights (counted as their sum: an upper bound); a back-to-back
-    rack (``rows`` = 2) has two of each frame (its spacers add no node).
+    rack (``rows`` = 2) has two of each frame; spacers off those heights add theirs, counted
+    by the caller among ``panel_points`` (``model.load._check_size``).
     """
     lines = n_bays + 1
     if not three_d:

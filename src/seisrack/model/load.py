@@ -20,9 +20,16 @@ from pathlib import Path
 from typing import Any
 
 from seisrack.errors import FileFormatError, InputError
-from seisrack.limits import MAX_COUNT, MAX_SUBDIVISIONS, check_rack_size, rack_size
+from seisrack.limits import (
+    MAX_COUNT,
+    MAX_RACK_DOFS,
+    MAX_SUBDIVISIONS,
+    check_rack_size,
+    rack_size,
+)
 from seisrack.model._reader import Table, check_friction, check_number
 from seisrack.model.loading import place_pallets, read_loading
+from seisrack.model.row_spacer import NODE_MERGE, check_spacer_nodes, read_rows
 from seisrack.model.spec import (
     DEFAULT_G,
     DEFAULT_PALLET_WIDTH,
@@ -37,7 +44,6 @@ from seisrack.model.spec import (
     Material,
     Pallet,
     RackSpec,
-    RowSpacer,
     SecondOrder,
     Section,
 )
@@ -80,6 +86,10 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
     geometry = _geometry(root.table("geometry"), sections)
     connections = _connections(root.table("connections"), three_d)
     bracing = _bracing(root, geometry, sections)
+    spacers = None
+    if geometry.row_spacer is not None:
+        spacers = root.table("geometry").table("row_spacer")
+        check_spacer_nodes(spacers, geometry, bracing)
     damping = _damping(root.table("damping", {}))
     second_order = _second_order(root.table("second_order", {}))
     hysteresis = _hysteresis(root.table("hysteresis", {}), connections)
@@ -96,7 +106,7 @@ def rack_from_dict(d: Any, source: str | None = None) -> RackSpec:
                      lt.path, source)
         loading = read_loading(rest, geometry)
     root.finish(_TOP_KEYS)
-    _check_size(geometry, bracing, loading, len(explicit), source)
+    _check_size(geometry, bracing, loading, len(explicit), source, spacers)
     pallets, labels = place_pallets(loading, geometry, explicit)
     fields = [{k: f"{lab}.{k}" for k in _PALLET_3D_KEYS} for lab in labels]
     if footprint:  # [loading] depth/overhang: for the pallets that do not give their own
@@ -192,7 +202,7 @@ def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
     bays = _lengths(t, "bays")
     levels = _lengths(t, "levels")
     depth = t.number("depth", positive=True, unit="m") if t.has("depth") else None
-    rows, spacer = _rows(t, sum(levels), depth, sections)
+    rows, spacer = read_rows(t, sum(levels), depth, sections)
     geom = Geometry(
         bays=bays, levels=levels,
         beam_sections=_section_names(t, "beam_section", len(levels), "level", sections),
@@ -205,58 +215,6 @@ def _geometry(t: Table, sections: dict[str, Section]) -> Geometry:
     return geom
 
 
-def _rows(t: Table, top: float, depth: float | None, sections: dict[str, Section]
-          ) -> tuple[int, RowSpacer | None]:
-    """``rows`` (1, or 2 back to back) and ``[geometry.row_spacer]``: 3D racks only."""
-    if depth is None:
-        for key in ("rows", "row_spacer"):
-            if t.has(key):
-                raise t.error(key, t.raw(key), "no rows or row spacers in a 2D rack (they "
-                              "are keys of a 3D rack)", hint="Give [geometry] depth (the "
-                              "upright-frame depth, m) for a 3D rack, then rows = 2 and "
-                              "[geometry.row_spacer] for a back-to-back (double-entry) rack")
-        return 1, None
-    rows = t.integer("rows", 1)
-    if rows not in (1, 2):
-        raise t.error("rows", rows, "1 (one row of upright frames) or 2 (two rows back to "
-                                    "back, joined by [geometry.row_spacer])")
-    if rows == 1:
-        if t.has("row_spacer"):
-            raise t.error("row_spacer", t.raw("row_spacer"), "no row spacer on a rack of one "
-                          "row", hint="Set [geometry] rows = 2 for a back-to-back rack")
-        return 1, None
-    if not t.has("row_spacer"):
-        raise t.error("row_spacer", None, "a [geometry.row_spacer] table (length, section, "
-                      "spacing or heights): two rows back to back are joined by row spacers")
-    st = t.table("row_spacer")
-    length = st.number("length", positive=True, unit="m")
-    section = st.string("section")
-    if section not in sections:
-        raise st.error("section", section, f"one of the [sections]: {', '.join(sorted(sections))}")
-    if st.has("spacing") == st.has("heights"):
-        raise st.error("spacing", st.raw("spacing", None), "either spacing (a vertical spacing, "
-                       "m) or heights (a list of heights, m), not both and not neither")
-    if st.has("spacing"):
-        h = st.number("spacing", positive=True, unit="m")
-        if h > top + _GEOM_TOL:
-            raise st.error("spacing", h, f"a spacing <= the upright height {top:g} m (a "
-                           "spacer must fit on the uprights)")
-        n = int(math.floor(top / h + 1e-9))
-        heights = [k * h for k in range(1, n + 1)]
-        if top - heights[-1] > 1e-6 * top:
-            heights.append(top)  # and one at the top of the uprights
-    else:
-        raw = st.array("heights", min_len=1)
-        heights = [check_number(v, f"{st.field('heights')}[{i}]", positive=True, unit="m",
-                                source=st.source) for i, v in enumerate(raw)]
-        if any(b <= a for a, b in zip(heights[:-1], heights[1:], strict=True)) \
-                or heights[-1] > top + _GEOM_TOL:
-            raise st.error("heights", raw, f"an increasing list of heights in (0, {top:g}] m "
-                           "(on the uprights, above the floor)")
-    st.finish(("length", "section", "spacing", "heights"))
-    return 2, RowSpacer(length=length, section=section, heights=tuple(heights))
-
-
 def _subdivisions(t: Table) -> int:
     n = t.integer("subdivisions", DEFAULT_SUBDIVISIONS, minimum=1)
     if n > MAX_SUBDIVISIONS:
@@ -266,15 +224,38 @@ def _subdivisions(t: Table) -> int:
 
 
 def _check_size(geom: Geometry, bracing: Any, loading: Any, n_explicit: int,
-                source: str | None) -> None:
-    """Refuse a rack too large to build before it is meshed (or its pallets placed)."""
+                source: str | None, spacers: Table | None = None) -> None:
+    """Refuse a rack too large to build before it is meshed (or its pallets placed); name
+    the row spacers (``spacers``: their table) when their nodes alone make it too large."""
     n_pallets = n_explicit
     if loading is not None:  # an upper bound: every slot of every loaded level
         n_pallets += (sum(1 for lv in loading.levels if loading.level_mass[lv - 1] > 0)
                       * geom.n_bays * loading.pallets_per_bay * geom.rows)
-    points = 0 if bracing is None else _extra_heights(geom, bracing.panel_points)
-    size = rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
-                     three_d=geom.depth is not None, panel_points=points, rows=geom.rows)
+
+    def size_of(extra_heights: int) -> Any:
+        return rack_size(geom.n_bays, geom.n_levels, geom.subdivisions, n_pallets,
+                         three_d=geom.depth is not None, panel_points=extra_heights,
+                         rows=geom.rows)
+
+    panel = () if bracing is None else bracing.panel_points
+    points = _extra_heights(geom, panel)
+    size = size_of(points)
+    if spacers is not None and size.dofs <= MAX_RACK_DOFS:
+        heights = geom.row_spacer.heights  # type: ignore[union-attr]
+        merged: list[float] = []  # spacers off the nodes add a node on every upright
+        for y in sorted(panel + heights):
+            if not merged or y - merged[-1] > NODE_MERGE:
+                merged.append(y)
+        full = size_of(_extra_heights(geom, tuple(merged)))
+        if full.dofs > MAX_RACK_DOFS:
+            key = "spacing" if spacers.has("spacing") else "heights"
+            raise spacers.error(
+                key, spacers.raw(key) if key == "spacing" else f"{len(heights)} heights",
+                f"row spacers that leave the rack at most {MAX_RACK_DOFS:,} degrees of freedom",
+                hint=f"A spacer off the upright nodes adds a node on every upright: with these "
+                     f"{len(heights):,} spacers on each upright line the rack has about "
+                     f"{full.dofs:,} DOFs ({size.dofs:,} without); put them at the beam levels "
+                     "or the bracing panel points, or use fewer")
     check_rack_size(size, n_bays=geom.n_bays, n_levels=geom.n_levels,
                     default_subdivisions=DEFAULT_SUBDIVISIONS,
                     subdivisions=geom.subdivisions,
