@@ -95,3 +95,16 @@ def test_timings_reported(report):
     t = summary["timings_s"]
     assert t["total"] > 0 and t["command_wall"] >= t["total"]
     assert any(k.startswith("§IV") for k in t)
+
+
+def test_a_3d_rack_is_refused_before_anything_runs(tmp_path, capsys):
+    """§IV is the paper's plane frame: a 3D rack given with --rack once ran §II-§IV and then
+    failed in the §IV checks with an internal error (friction with a direction axis)."""
+    from pathlib import Path
+
+    rack = Path(__file__).resolve().parents[1] / "examples" / "paper_rack_3d.toml"
+    out = tmp_path / "p"
+    assert main(["paper", "--quick", "--rack", str(rack), "--out", str(out), "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == "--rack" and "2D rack" in err["allowed"]
+    assert not out.exists()

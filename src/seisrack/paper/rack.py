@@ -106,6 +106,10 @@ def find_paper_rack(path: str | Path | None = None) -> Path:
         p = Path(path)
         if not p.is_file():
             raise InputError("--rack", str(path), "an existing rack TOML file")
+        if load_rack(p).geometry.depth is not None:
+            raise InputError("--rack", str(path), "a 2D rack file: §IV is the paper's plane "
+                             "frame, its checks compare one direction", hint="For a 3D rack "
+                             "use seisrack run or seisrack report")
         return p
     here = Path(__file__).resolve()
     for cand in (Path("examples/paper_rack.toml"), here.parents[3] / "examples/paper_rack.toml"):

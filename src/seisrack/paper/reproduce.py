@@ -157,11 +157,12 @@ def reproduce_paper(
     ``examples/paper_rack.toml``). executor: runs §II and §III concurrently if given.
     progress: called with (section title, seconds) as each section finishes.
     """
-    from seisrack.paper.rack import SEED, make_record, suite_size
+    from seisrack.paper.rack import SEED, find_paper_rack, make_record, suite_size
     from seisrack.paper.rack_md import run_rack_section
     from seisrack.paper.sdof import run_sdof
     from seisrack.paper.validation import run_validation_section
 
+    find_paper_rack(rack)  # a rack §IV cannot take is refused before §II and §III run
     t_all = time.perf_counter()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
