@@ -24,6 +24,7 @@ pa = pytest.importorskip("pyarrow")
 pq = pytest.importorskip("pyarrow.parquet")
 
 from seisrack.cli import main  # noqa: E402
+from seisrack.errors import InputError  # noqa: E402
 from seisrack.studies import fragility as fr  # noqa: E402
 from seisrack.studies.summary import summarize  # noqa: E402
 
@@ -205,7 +206,7 @@ def test_summary_main_text(stripes_store, capsys):
     assert "67 runs, 64 ok, 3 failed" in text and "sliding>0.05m" in text
 
 
-@pytest.mark.parametrize("case", ["missing", "empty", "no_parts", "bad_d"])
+@pytest.mark.parametrize("case", ["missing", "empty", "no_parts", "bad_d", "same_d"])
 def test_summary_main_bad_input(tmp_path, capsys, case):
     target = tmp_path / "study"
     args = [str(target)]
@@ -216,12 +217,19 @@ def test_summary_main_bad_input(tmp_path, capsys, case):
     elif case == "bad_d":
         _write(target, [_row(0)], parts=1)
         args += ["--d-slide", "-1"]
+    elif case == "same_d":  # one damage state name twice: its counts were pooled
+        _write(target, [_row(0)], parts=1)
+        args += ["--d-slide", "0.05", "0.05000000001"]
     code = summary_main(args)
     err = capsys.readouterr().err
     assert code == 2
     assert err.startswith("seisrack: error:") and "Traceback" not in err
     assert err.count("\n") == 1
-    assert ("--d-slide" in err) if case == "bad_d" else (str(target) in err)
+    assert ("--d-slide" in err) if case.endswith("_d") else (str(target) in err)
+    if case == "same_d":
+        assert "0.05 m is given twice" in err
+        with pytest.raises(InputError, match="d_slide"):
+            summarize(target, d_slide=[0.1, 0.1])
 
 
 def test_local_reader_dedups_and_sorts(tmp_path):

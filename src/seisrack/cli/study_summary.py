@@ -47,7 +47,12 @@ MAX_BOOT = 100_000
 def run(argv: list[str]) -> int:
     from seisrack.cli._common import print_json
     from seisrack.errors import InputError
-    from seisrack.studies.summary import _jsonable, format_summary, summarize
+    from seisrack.studies.summary import (
+        _jsonable,
+        check_distinct_thresholds,
+        format_summary,
+        summarize,
+    )
 
     a = parser().parse_args(argv)
     if not 0 <= a.boot <= MAX_BOOT:
@@ -56,6 +61,7 @@ def run(argv: list[str]) -> int:
         raise InputError("--seed", a.seed, "an integer >= 0")
     if any(not (math.isfinite(d) and d > 0) for d in a.d_slide):
         raise InputError("--d-slide", a.d_slide, "sliding thresholds > 0 [m]")
+    check_distinct_thresholds("--d-slide", a.d_slide)
     if a.shear_capacity is not None and not (math.isfinite(a.shear_capacity)
                                              and a.shear_capacity > 0):
         raise InputError("--shear-capacity", a.shear_capacity, "a base shear capacity > 0 [N]")

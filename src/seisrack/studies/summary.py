@@ -112,6 +112,17 @@ def runs_as_arrays(table) -> dict[str, np.ndarray]:  # noqa: ANN001
     return out
 
 
+def check_distinct_thresholds(field: str, d_slide) -> None:  # noqa: ANN001
+    """Refuse two sliding thresholds that name the same damage state (``sliding>0.05m``: six
+    significant digits), whose counts would otherwise be pooled under one name."""
+    names = [f"{d:g}" for d in d_slide]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError(field, list(d_slide), "distinct sliding thresholds [m] (six "
+                         f"significant digits tell them apart): {', '.join(dup)} m is given "
+                         "twice")
+
+
 def _damage_states(d_slide, shear_capacity) -> list[tuple[str, str, float]]:
     """(name, column, threshold): exceeding means column > threshold."""
     states = [(f"sliding>{d:g}m", "peak_sliding_max_m", float(d)) for d in d_slide]
@@ -259,6 +270,7 @@ def summarize(out_dir: str | Path, *, d_slide=DEFAULT_D_SLIDE, shear_capacity: f
     d_slide = (float(d_slide),) if np.isscalar(d_slide) else tuple(float(d) for d in d_slide)
     if not d_slide or any(not (d > 0) for d in d_slide):
         raise InputError("d_slide", d_slide, "one or more sliding thresholds > 0 [m]")
+    check_distinct_thresholds("d_slide", d_slide)
     if shear_capacity is not None and not (shear_capacity > 0):
         raise InputError("shear_capacity", shear_capacity, "a base shear capacity > 0 [N]")
     from seisrack.studies.store import StoreError, check_parts, planned_stripes, read_study_json
