@@ -168,3 +168,33 @@ def test_cli_study_summary_dispatch(study: Path, tmp_path: Path,
     assert main(["study", "summary", str(out), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["runs_total"] == 12 and doc["runs_ok"] == 12 and doc["runs_failed"] == 0
+
+
+def test_local_workers_are_bounded(study: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                   capsys: pytest.CaptureFixture) -> None:
+    """--workers 300 on 2 cores forked 300 processes for a 6-run study (9 GB, 12 times
+    slower). At most LOCAL_WORKERS_PER_CPU per CPU, and no more processes than batches."""
+    import os
+
+    from seisrack.cli import main
+    from seisrack.errors import InputError
+    from seisrack.studies import executors
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    out = tmp_path / "out"
+    assert main(["study", str(study), "--out", str(out), "--workers", "300", "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == "--workers" and "at most 8 local workers" in err["allowed"]
+    assert not out.exists()
+    with pytest.raises(InputError, match="workers"):
+        run_study(load_study(study), tmp_path / "api", workers=9, progress=False)
+    sizes = []
+    real = executors.LocalExecutor.__init__
+
+    def spy(self, pl, n, *args, **kw):  # noqa: ANN001, ANN002, ANN003, ANN202
+        sizes.append(n)
+        real(self, pl, n, *args, **kw)
+
+    monkeypatch.setattr(executors.LocalExecutor, "__init__", spy)
+    s = run_study(load_study(study), tmp_path / "b", workers=8, batch_size=6, progress=False)
+    assert s.runs_ok == 12 and sizes == [2]  # 12 runs in batches of 6: two processes

@@ -82,6 +82,10 @@ def _run_study(args: argparse.Namespace) -> int:
         extra.parse_args(args.rest, namespace=args)
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers", args.workers, "an integer >= 1")
+    if args.executor == "local" and not args.scheduler:
+        from seisrack.studies.run import check_local_workers
+
+        check_local_workers(args.workers, "--workers")
     if args.batch_size is not None and args.batch_size < 1:
         raise InputError("--batch-size", args.batch_size, "an integer >= 1")
     if not args.out and not args.dry_run:
