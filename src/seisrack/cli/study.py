@@ -35,7 +35,7 @@ def _add_options(p: argparse.ArgumentParser, defaults: bool = True) -> None:
     p.add_argument("--dry-run", action="store_true", default=d(False),
                    help="print the run table and exit")
     p.add_argument("--workers", type=int, default=d(None), metavar="N",
-                   help="worker processes (default: one per core)")
+                   help="worker processes (default: one per core; locally at most four per core)")
     p.add_argument("--executor", choices=("local", "dask"), default=d("local"),
                    help="local process pool (default) or a Dask LocalCluster")
     p.add_argument("--scheduler", metavar="ADDR", default=d(None),
