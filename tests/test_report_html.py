@@ -120,6 +120,9 @@ def test_report_is_self_contained_with_every_section(case, tmp_path):
     # every figure has a caption
     assert text.count("<figure") == text.count("<figcaption>")
     assert "@page { size: A4" in text and "break-before: page" in text
+    # a value not assessed (the paper's rule without --rigid-check, a factor not set) reads
+    # "–" in a client's deliverable, not Python's None
+    assert ">None<" not in text
 
 
 def test_tables_hold_the_numbers_of_summary(case, tmp_path):

@@ -190,7 +190,7 @@ def _checks_html(checks: dict[str, Any]) -> str:
         out.insert(0, '<div class="disagree"><b>Checks that disagree with the time history:'
                       "</b><ul>" + "".join(f"<li>{esc(d)}</li>" for d in checks["disagreements"])
                    + "</ul></div>")
-    fac = "".join(f"<tr><td>{esc(k)}</td><td>{esc(v)}</td>"
+    fac = "".join(f"<tr><td>{esc(k)}</td><td>{_text(v)}</td>"
                   f"<td>{esc(checks.get('factor_sources', {}).get(k, ''))}</td></tr>"
                   for k, v in checks.get("factors", {}).items())
     out.append('<table id="table-factors"><caption>Factors used by the checks and their '
@@ -200,12 +200,17 @@ def _checks_html(checks: dict[str, Any]) -> str:
     return "".join(out)
 
 
+def _text(v: Any) -> str:
+    """A table cell's text: "–" for a value that was not assessed (None), never "None"."""
+    return "–" if v is None else esc(v)
+
+
 def _rows_table(tid: str, rows: list[dict[str, Any]], cols: list[tuple[str, str, float, str]],
                 caption: str) -> str:
     head = "".join(f"<th>{esc(h)}</th>" for _, h, _, _ in cols)
     body = "".join("<tr>" + "".join(
         num_cell(r.get(k), f, fmt, k) if isinstance(r.get(k), float) else
-        f'<td data-key="{esc(k)}">{esc(r.get(k))}</td>' for k, _, f, fmt in cols) + "</tr>"
+        f'<td data-key="{esc(k)}">{_text(r.get(k))}</td>' for k, _, f, fmt in cols) + "</tr>"
         for r in rows)
     return (f'<table id="{tid}"><caption>{esc(caption)}</caption><thead><tr>{head}</tr>'
             f"</thead><tbody>{body}</tbody></table>")
