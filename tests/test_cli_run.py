@@ -239,6 +239,16 @@ def test_a_filter_below_its_lowest_cut_off_is_refused(capsys, rec_csv):
     assert err["field"] == "--accel-filter" and ">= 0.1 Hz" in err["allowed"]
 
 
+@pytest.mark.parametrize(("opts", "field"), [(["--scale", "1e300"], "--scale"),
+                                           (["--scale-pga", "200", "--scale-units", "g"],
+                                            "--scale-pga")])
+def test_a_scaling_beyond_any_earthquake_is_refused(capsys, rec_csv, opts, field):
+    """--scale 1e300 overflowed the response (inf peaks, a NaN energy residual) and ran on."""
+    assert main(["run", str(PAPER_RACK), "--motion", str(rec_csv), *opts, "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert err["field"] == field and "<= 100 g" in err["allowed"]
+
+
 def test_subprocess_json_and_error(rec_csv, tmp_path: Path):
     def run(*args: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run([sys.executable, "-m", "seisrack", "run", str(PAPER_RACK), *args],

@@ -69,10 +69,21 @@ def test_design_spectrum_lower_bound_governs() -> None:
         0.2 * G * 2.5 / 4 * 0.4 * 2.0 / 16.0, rel=1e-12)
 
 
-@pytest.mark.parametrize("q", [0.9, 0.0, -1.0, math.nan, math.inf])
+@pytest.mark.parametrize("q", [0.9, 0.0, -1.0, math.nan, math.inf, 10.5, 1e300])
 def test_q_below_one_is_refused(q: float) -> None:
-    with pytest.raises(InputError, match="q >= 1"):
+    with pytest.raises(InputError, match="q >= 1"):  # 1e300 made the design drifts overflow
         design_spectrum(1, "C", 0.3, q)
+
+
+@pytest.mark.parametrize(("kw", "field"), [
+    (dict(ag=1e300), "ag"), (dict(ag=3.01), "ag"), (dict(ag=30.0, ag_units="m/s2"), "ag"),
+    (dict(importance=1e300), "importance"), (dict(importance=3.5), "importance")])
+def test_absurd_ground_accelerations_are_refused(kw: dict, field: str) -> None:
+    """ag = 1e300 g gave inf forces and NaN drifts reported "ok": at most 3 g, gamma_I 3."""
+    with pytest.raises(InputError) as exc:
+        design_spectrum(**dict(dict(type=1, ground="C", ag=0.3, q=1.5), **kw))
+    assert exc.value.field == field
+    assert design_spectrum(1, "C", 3.0, 1.5, importance=3.0).psa(0.5) > 0.0  # the bounds run
 
 
 def test_factor_table_validation() -> None:

@@ -12,6 +12,9 @@ from typing import Any
 
 #: [g] a record PGA above this draws a warning (issue #14: implausible input)
 PGA_WARN_G = 3.0
+#: [g] a scaling that takes the record's PGA above this is refused: no earthquake comes near,
+#: and --scale 1e300 overflowed the response to inf and NaN, reported as a result
+PGA_MAX_G = 100.0
 
 
 def _check_number(name: str, value: float | None, allowed: str, ok: bool) -> None:
@@ -162,6 +165,14 @@ def _apply_scaling(args: argparse.Namespace, model: Any, rec: Any,
     else:
         return rec, vert, None
     new, info = scale_record(rec, **kw)
+    if not new.pga <= PGA_MAX_G * G:
+        opt = ("--scale-pga" if args.scale_pga is not None else "--scale-sa VALUE"
+               if args.scale_sa is not None else "--scale")
+        given = args.scale_pga if args.scale_pga is not None else (
+            args.scale_sa[1] if args.scale_sa is not None else args.scale)
+        raise InputError(opt, given, f"a scaling that leaves the record's PGA <= "
+                         f"{PGA_MAX_G:g} g (this one gives {new.pga / G:.3g} g)",
+                         hint="Check the scaling target and its units (--scale-units)")
     if args.scale_sa is not None:
         info["period_from"] = "T1" if args.scale_sa[0].strip().lower() == "t1" else "given"
     if vert is not None:

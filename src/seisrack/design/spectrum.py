@@ -74,10 +74,17 @@ class EC8DesignSpectrum:
         return out
 
 
+#: largest behaviour factor accepted: EN 16681 gives racks q up to 4, EN 1998-1 the most
+#: ductile steel frames about 6.5; above 10 the value is a slip (q = 1e300 made the design
+#: drifts q d_e overflow)
+Q_MAX = 10.0
+
+
 def check_q(q: float, field: str = "q") -> float:
     """q as a float, or an InputError: a behaviour factor >= 1 (1 = elastic)."""
-    if isinstance(q, bool) or not isinstance(q, int | float) or not math.isfinite(q) or q < 1:
-        raise InputError(field, q, "a behaviour factor q >= 1 (1 = elastic)")
+    if isinstance(q, bool) or not isinstance(q, int | float) or not math.isfinite(q) or q < 1 \
+            or q > Q_MAX:
+        raise InputError(field, q, f"a behaviour factor q >= 1 (1 = elastic) and <= {Q_MAX:g}")
     return float(q)
 
 

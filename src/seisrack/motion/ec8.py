@@ -126,6 +126,14 @@ class EC8Spectrum:
         return out
 
 
+#: [g] largest reference peak ground acceleration a spectrum is built for: EN 1998-1's national
+#: zonation maps stay below 1 g; far above, the value is a unit slip (m/s² given as g), and
+#: at 1e300 g the design forces overflowed to inf with the run reported "ok"
+AG_MAX_G = 3.0
+#: largest importance factor γ_I (EN 1998-1 Table 4.3 gives 0.8–1.4)
+IMPORTANCE_MAX = 3.0
+
+
 def ec8_spectrum(
     type: int | str = 1,
     ground: str = "C",
@@ -156,15 +164,19 @@ def ec8_spectrum(
         kind = -1
     if kind not in (1, 2):
         raise InputError("type", type, "1 or 2")
-    if not (isinstance(ag, int | float) and math.isfinite(ag) and ag > 0):
-        raise InputError("ag", ag, "a peak ground acceleration > 0")
-    if not (isinstance(damping, int | float) and 0.0 <= damping < 1.0):
-        raise InputError("damping", damping, "a damping ratio in [0, 1), e.g. 0.05")
-    if not (isinstance(importance, int | float) and math.isfinite(importance) and importance > 0):
-        raise InputError("importance", importance, "an importance factor > 0 (e.g. 0.8–1.4)")
-    units = ag_units.strip().lower()
+    units = ag_units.strip().lower() if isinstance(ag_units, str) else ag_units
     if units not in ("g", "m/s2"):
         raise InputError("ag_units", ag_units, "'g' or 'm/s2'")
+    top = AG_MAX_G * (1.0 if units == "g" else G)
+    if not (isinstance(ag, int | float) and math.isfinite(ag) and 0 < ag <= top):
+        raise InputError("ag", ag, f"a peak ground acceleration > 0 and <= {top:g} "
+                         + ("g" if units == "g" else f"m/s² ({AG_MAX_G:g} g)"))
+    if not (isinstance(damping, int | float) and 0.0 <= damping < 1.0):
+        raise InputError("damping", damping, "a damping ratio in [0, 1), e.g. 0.05")
+    if not (isinstance(importance, int | float) and math.isfinite(importance)
+            and 0 < importance <= IMPORTANCE_MAX):
+        raise InputError("importance", importance, f"an importance factor > 0 and <= "
+                         f"{IMPORTANCE_MAX:g} (EN 1998-1 Table 4.3: 0.8–1.4)")
     ag_si = float(ag) * (G if units == "g" else 1.0) * float(importance)
     if direction == "horizontal":
         g = str(ground).strip().upper()
