@@ -58,6 +58,19 @@ def test_at2_errors_give_line_numbers(tmp_path: Path) -> None:
         read_record(_write(tmp_path, "e.AT2", AT2), units="m/s2")
 
 
+@pytest.mark.parametrize("dt", ["1e-300", "1e-7", "1e300", "2.0"])
+def test_a_step_no_accelerogram_has_is_refused(tmp_path: Path, dt: str) -> None:
+    """DT = 1e-300 reached the acceleration filter's design (a LinAlgError), 1e300 was blamed
+    on --dt: the readers take steps from 1e-6 to 1 s, naming the line."""
+    with pytest.raises(FileFormatError, match="not the step of an accelerogram") as exc:
+        read_record(_write(tmp_path, "x.AT2", AT2.replace("DT=   .0100", f"DT= {dt}")))
+    assert exc.value.line == 4
+    t = [0.0, float(dt), 2 * float(dt)]
+    text = "time_s,accel_m_s2\n" + "".join(f"{x!r},0.1\n" for x in t)
+    with pytest.raises(FileFormatError, match="not the step of an accelerogram"):
+        read_record(_write(tmp_path, "x.csv", text))
+
+
 def test_one_and_two_column_text(tmp_path: Path) -> None:
     one = _write(tmp_path, "one.txt", "# comment\n0.0\n0.5\n-0.5\n0.0\n")
     r1 = read_record(one, units="m/s2", dt=0.02)

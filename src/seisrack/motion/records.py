@@ -31,6 +31,12 @@ _SEP = re.compile(r"[,;\s]+")
 _HEADER = "time_s,accel_m_s2"
 # relative tolerance on time steps read from a time column (files carry ~6 significant digits)
 _DT_RTOL = 1e-4
+#: [s] shortest time step of a ground motion: accelerograms are sampled at 50-1000 Hz; a step
+#: of 1e-300 s (a PEER file's DT) reached the acceleration filter's design, singular there
+MIN_DT = 1e-6
+#: [s] longest time step of a record file (a sample a second at most; 1e300 s passed the reader
+#: and was blamed on --dt)
+MAX_DT = 1.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,8 +65,9 @@ class Record:
         if bad.size:
             raise InputError("accel", f"non-finite value at sample {bad[0]}", "finite numbers")
         dt = float(self.dt)
-        if not (math.isfinite(dt) and dt > 0.0):
-            raise InputError("dt", self.dt, "a finite time step > 0 s")
+        if not (math.isfinite(dt) and dt >= MIN_DT):
+            raise InputError("dt", self.dt, f"a finite time step >= {MIN_DT:g} s (an "
+                             "accelerogram sampled at most at 1 MHz)")
         a.setflags(write=False)
         object.__setattr__(self, "accel", a)
         object.__setattr__(self, "dt", dt)
@@ -130,6 +137,9 @@ def _read_at2(path: str, lines: list[str]) -> tuple[np.ndarray, float, str]:
             raise FileFormatError(path, "line 4 must give NPTS and DT", 4) from None
     if npts < 2 or not (math.isfinite(dt) and dt > 0):
         raise FileFormatError(path, f"invalid NPTS={npts} or DT={dt}", 4)
+    if not MIN_DT <= dt <= MAX_DT:
+        raise FileFormatError(path, f"DT={dt:g} s is not the step of an accelerogram "
+                              f"({MIN_DT:g} to {MAX_DT:g} s)", 4)
     vals: list[float] = []
     for lineno, line in enumerate(lines[4:], start=5):
         for tok in line.split():
@@ -185,6 +195,9 @@ def _read_columns(
     dt_file = float(t[1] - t[0])  # the first step is the reference: report the first deviation
     if not dt_file > 0:
         raise FileFormatError(path, "time column is not increasing", linenos[1])
+    if not MIN_DT <= dt_file <= MAX_DT:
+        raise FileFormatError(path, f"a time step of {dt_file:g} s is not the step of an "
+                              f"accelerogram ({MIN_DT:g} to {MAX_DT:g} s)", linenos[1])
     bad = np.flatnonzero(np.abs(steps - dt_file) > _DT_RTOL * dt_file + 1e-9)
     if bad.size:
         k = bad[0]
