@@ -95,7 +95,8 @@ def inprocess(cfg: dict) -> dict:
     pl = plan(load_study(cfg["toml"]))
     out = {}
     for label, records in (("real", pl.records), ("short", {
-            h: Record(r.accel[:10], r.dt, name=r.name) for h, r in pl.records.items()})):
+            h: tuple(Record(c.accel[:10], c.dt, name=c.name) for c in comps)
+            for h, comps in pl.records.items()})):
         ex._set_context(replace(pl, runs=(), records=records), label)
         for r in pl.runs[:5]:
             ex.run_one(r)
@@ -132,8 +133,9 @@ def child(cfg: dict) -> dict:
     t_plan = time.perf_counter() - t0
     if cfg.get("noop_samples"):
         k = int(cfg["noop_samples"])
-        pl = replace(pl, records={h: Record(r.accel[:k], r.dt, name=r.name)
-                                  for h, r in pl.records.items()})
+        pl = replace(pl, records={h: tuple(Record(c.accel[:k], c.dt, name=c.name)
+                                           for c in comps)
+                                  for h, comps in pl.records.items()})
     c0 = os.times()
     t1 = time.perf_counter()
     s = run_study(pl, cfg["out"], executor=cfg["executor"], workers=cfg["workers"],
