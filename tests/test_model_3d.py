@@ -117,6 +117,11 @@ BAD = [
     ("member index", lambda d: d["bracing"].update(pattern=[["F0", "R9"]]),
      "bracing.pattern[0]"),
     ("panel above top", lambda d: d["bracing"].update(panel=[0.0, 4.0]), "bracing.panel"),
+    # panel points 0.1 mm apart, or a 0.1 mm sliver under the top (3 m uprights), made nodes
+    # that close that the stability check called the bracing a mechanism
+    ("panel points too close", lambda d: d["bracing"].update(panel=[0.0, 1.5, 1.5001, 3.0]),
+     "bracing.panel[2]"),
+    ("panel sliver at the top", lambda d: d["bracing"].update(panel=0.7499), "bracing.panel"),
     ("missing section", lambda d: d["bracing"].pop("diagonal_section"),
      "bracing.diagonal_section"),
     ("missing bracing", lambda d: d.pop("bracing"), "bracing"),
@@ -144,6 +149,14 @@ def test_bad_input_names_the_field(name, mutate, field):
     with pytest.raises(InputError) as exc:
         compile_rack(rack_from_dict(_bad(mutate)))
     assert exc.value.field == field, str(exc.value)
+
+
+@pytest.mark.parametrize("panel", [[0.0, 1.5, 1.55, 3.0], 0.73])
+def test_panel_points_at_the_gap_bound_build(panel):
+    """0.05 m between panel points, and a last panel of 0.08 m under the top, are accepted."""
+    d = rack_3d()
+    d["bracing"]["panel"] = panel
+    assert compile_rack(rack_from_dict(d)).n_dof > 0
 
 
 def test_2d_rack_refuses_3d_keys():

@@ -33,6 +33,16 @@ MAX_SUBDIVISIONS = 100
 #: Most panel points on one upright (3D bracing). A 0.1 m panel on a 30 m upright gives 300;
 #: beyond, the ``panel`` is almost surely a unit error (mm for m).
 MAX_PANEL_POINTS = 1_000
+#: [m] closest two heights on an upright may be without sharing a node: row spacers, bracing
+#: panel points. Bolted parts sit in the upright's perforations, about 50 mm apart, and the
+#: model ignores joint eccentricities of that size; nearer heights are one joint, and the short
+#: upright element between two nodes (bending stiffness ~ 1/L³) makes the stiffness near
+#: singular: measured 0.1 mm apart (the "mechanism" check of the bracing fails), 1 mm (a damping
+#: matrix asymmetric by round-off), while 0.05 m is at most (L / 0.05)³ stiffer than an element
+#: of length L (2.7e4 for a 1.5 m storey in one element), far from both. Storey divisions (mesh
+#: nodes) need only a quarter of a division when that is less: the short element is then at
+#: most 4³ = 64 times stiffer than its division.
+MIN_NODE_GAP = 0.05
 #: Most degrees of freedom of a rack. Measured here: compiling a 247,021-DOF rack and its
 #: first 6 modes took 8 s and 360 MB; a 102,381-DOF rack with 12,000 pallets 35 s and 360 MB.
 #: The largest example is 3,481 DOFs (2D) and the 5 x 10 warehouse rack 3D about 10,000.

@@ -33,7 +33,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from seisrack.limits import MAX_PANEL_POINTS
+from seisrack.limits import MAX_PANEL_POINTS, MIN_NODE_GAP
 from seisrack.model._reader import Table, check_number
 
 PATTERNS = ("Z", "D", "K", "X")
@@ -116,6 +116,12 @@ def _panel_points(t: Table, top: float) -> tuple[float, ...]:
                 or pts[-1] > top + _TOL:
             raise t.error("panel", raw, f"an increasing array of at least 2 heights in "
                                         f"[0, {top:g}] m (the top of the uprights)")
+        for i in range(1, len(pts)):
+            if pts[i] - pts[i - 1] < MIN_NODE_GAP - _TOL:
+                raise t.error(f"panel[{i}]", pts[i], f"a panel point at least {MIN_NODE_GAP:g} "
+                              f"m above the one before it (panel[{i - 1}] = {pts[i - 1]:g} m)",
+                              hint="Nearer points are one joint in this model, and upright "
+                                   "nodes that close make the stiffness matrix near singular")
         return tuple(pts)
     h = t.number("panel", positive=True, unit="m")
     if h > top + _TOL:
@@ -127,6 +133,11 @@ def _panel_points(t: Table, top: float) -> tuple[float, ...]:
                       hint=f"{h:g} m gives {n + 1:,} panel points; is the panel in metres?")
     pts = [k * h for k in range(n + 1)]
     if top - pts[-1] > 1e-6 * top:
+        if top - pts[-1] < MIN_NODE_GAP - _TOL:  # a sliver of a panel under the top point
+            raise t.error("panel", h, f"a panel height whose last point ({pts[-1]:g} m) is at "
+                          f"least {MIN_NODE_GAP:g} m below the top of the uprights ({top:g} m), "
+                          "or that divides it", hint="Nearer points are one joint in this "
+                          "model; or list the panel points with panel = [...]")
         pts.append(top)
     return tuple(pts)
 

@@ -16,7 +16,7 @@ import bisect
 import math
 from typing import Any
 
-from seisrack.limits import MAX_PANEL_POINTS
+from seisrack.limits import MAX_PANEL_POINTS, MIN_NODE_GAP
 from seisrack.model._reader import Table, check_number
 from seisrack.model.spec import Geometry, RowSpacer, Section
 
@@ -29,15 +29,8 @@ NODE_MERGE = 1e-6
 #: scaled that the stability check took an upright frame for a mechanism.
 _MIN_SPACER_LENGTH = 0.05
 #: [m] closest a spacer may be to another spacer, the base, a beam level or a bracing end on the
-#: same upright without sharing its node. Bolted parts sit in the upright's perforations, about
-#: 50 mm apart, and the model ignores joint eccentricities of that size; a nearer spacer is that
-#: joint, and the short upright element between the two nodes (bending stiffness ~ 1/L³) makes
-#: the stiffness near singular: measured 0.1 mm (the "mechanism" check fails), 1 mm spacers (a
-#: damping matrix asymmetric by round-off), while 0.05 m is at most (L / 0.05)³ stiffer than an
-#: element of length L (2.7e4 for a 1.5 m storey in one element), far from both. Storey
-#: divisions (mesh nodes) need only a quarter of a division when that is less: the short
-#: element is then at most 4³ = 64 times stiffer than its division.
-_MIN_SPACER_GAP = 0.05
+#: same upright without sharing its node (:data:`seisrack.limits.MIN_NODE_GAP`)
+_MIN_SPACER_GAP = MIN_NODE_GAP
 
 
 def read_rows(t: Table, top: float, depth: float | None, sections: dict[str, Section]
