@@ -230,3 +230,19 @@ def test_cli_report_scales_the_record_and_runs_the_rigid_check(tmp_path, capsys)
     assert main(["report", str(EXAMPLES / "paper_rack.toml"), "--builtin", "elcentro_1940_ns",
                  "--scale-pga", "-1", "--out", str(tmp_path / "bad" / "x.html")]) == 2
     assert "--scale-pga" in capsys.readouterr().err
+
+
+def test_cli_report_refuses_a_summary_folder_before_writing_anything(tmp_path, capsys):
+    """``summary.json`` beside the report is a folder: even with ``--force`` the command stops
+    with the usual error before it writes the report (it used to leave ``report.html``
+    behind and then fail on the summary)."""
+    from seisrack.cli import main
+
+    out = tmp_path / "report.html"
+    (tmp_path / "summary.json").mkdir()
+    assert main(["report", str(EXAMPLES / "three_level_rack.toml"), "--builtin",
+                 "elcentro_1940_ns", "--out", str(out), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert "summary.json" in err and "folder" in err and "Traceback" not in err
+    assert not out.exists()
+    assert (tmp_path / "summary.json").is_dir()

@@ -69,6 +69,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--modes", args.modes, f"an integer from 1 to {MAX_MODES:,}")
     out = check_report_path(args.out, args.force, field="--out")
     summary_path = out.with_name(SUMMARY_FILE)
+    if summary_path.exists() and not summary_path.is_file():  # checked before anything is written
+        raise InputError("--out", str(summary_path), "a folder where summary.json is a file "
+                         "(or absent): here it is a folder or a special file, which --force "
+                         "does not replace")
     if summary_path.exists() and not args.force:
         raise InputError("--out", str(summary_path), "a folder without summary.json",
                          hint="Pass --force to overwrite it")
