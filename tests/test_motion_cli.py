@@ -98,3 +98,23 @@ def test_check_folder_text_report(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert "3 records" in out and "smallest common scale factor" in out
     assert "after scaling every record by" in out
     assert rc in (0, 1) and ("does NOT comply" in out.split("after scaling")[1]) == (rc == 1)
+
+
+@pytest.mark.parametrize(("option", "value"), [
+    ("--ag", "-1"), ("--ag", "nan"), ("--importance", "9"), ("--duration", "-3"),
+    ("--dt", "0"), ("--damping", "2"), ("--seed", "-1"),
+])
+def test_generate_errors_name_the_option_typed(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str, value: str) -> None:
+    """A bad ``motion generate`` option is named as the user typed it (``--ag``), not by the
+    library's parameter (``ag``), and nothing is written."""
+    argv = ["motion", "generate", "--ag", "0.2", "--seed", "1",
+            "--out", str(tmp_path / "x.csv")]
+    if option in argv:
+        argv[argv.index(option) + 1] = value
+    else:
+        argv += [option, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"invalid value for '{option}'" in err and "Traceback" not in err
+    assert not (tmp_path / "x.csv").exists()

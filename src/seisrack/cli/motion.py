@@ -76,6 +76,12 @@ def register(subparsers: Any) -> None:
     c.set_defaults(func=_check)
 
 
+#: ``motion generate``'s options by the library parameter they set (its errors name those)
+_GENERATE_FLAGS = {"ag": "--ag", "importance": "--importance", "damping": "--damping",
+                   "duration": "--duration", "dt": "--dt", "seed": "--seed",
+                   "envelope_kind": "--envelope", "type": "--type", "ground": "--ground"}
+
+
 def _generate(args: argparse.Namespace) -> int:
     from seisrack.errors import InputError
     from seisrack.limits import MAX_SUITE_COUNT
@@ -101,10 +107,17 @@ def _generate(args: argparse.Namespace) -> int:
         )
     if not single and out.exists() and not out.is_dir():
         raise InputError("--out", str(out), "a folder (several records) or a .csv file path")
-    target = ec8_spectrum(args.type, args.ground, args.ag, damping=args.damping,
-                          importance=args.importance)
-    recs = generate_ec8_suite(args.count, seed=args.seed, spectrum=target,
-                              duration=args.duration, dt=args.dt, envelope_kind=args.envelope)
+    try:  # the library names its parameters; the user typed the options
+        target = ec8_spectrum(args.type, args.ground, args.ag, damping=args.damping,
+                              importance=args.importance)
+        recs = generate_ec8_suite(args.count, seed=args.seed, spectrum=target,
+                                  duration=args.duration, dt=args.dt,
+                                  envelope_kind=args.envelope)
+    except InputError as e:
+        flag = _GENERATE_FLAGS.get(e.field)
+        if flag is None:
+            raise
+        raise InputError(flag, e.value, e.allowed, source=e.source, hint=e.hint) from None
     if single:
         out.parent.mkdir(parents=True, exist_ok=True)
         paths = [write_record_csv(recs[0], out)]
