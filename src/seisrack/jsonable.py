@@ -1,7 +1,9 @@
-"""Conversion of results to plain JSON values (shared by the CLI and the report writers)."""
+"""Conversion of results to plain JSON values, and reading a JSON object back (shared by the
+CLI, the studies and the report writers)."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -28,3 +30,14 @@ def to_jsonable(obj: Any) -> Any:
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def read_json_object(path: str | Path) -> dict[str, Any] | None:
+    """The JSON object (a non-empty dict) in the file ``path``, or None when the file is absent,
+    unreadable, not JSON or holds something else. Python's parser also reads the ``NaN`` of
+    files written before ``null`` replaced it."""
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return doc if isinstance(doc, dict) and doc else None

@@ -44,7 +44,7 @@ from typing import Any
 
 from seisrack.atomic import atomic_write, write_text
 from seisrack.errors import InputError, SeisrackError
-from seisrack.jsonable import to_jsonable
+from seisrack.jsonable import read_json_object, to_jsonable
 
 #: row columns in order: (name, pyarrow type name)
 COLUMNS = (
@@ -255,15 +255,9 @@ def read_runs(out_dir: str | Path, columns: list[str] | None = None):  # noqa: A
 
 
 def read_study_json(out_dir: str | Path) -> dict[str, Any] | None:
-    """The document of ``out_dir/study.json``, or None when it is absent or unreadable.
-
-    Accepts files written before ``null`` replaced ``NaN`` (Python's parser reads both).
-    """
-    try:
-        doc = json.loads((Path(out_dir) / STUDY_JSON).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) else None
+    """The document of ``out_dir/study.json``, or None when it is absent, unreadable or empty
+    (files written before ``null`` replaced ``NaN`` are read too)."""
+    return read_json_object(Path(out_dir) / STUDY_JSON)
 
 
 def planned_stripes(doc: dict[str, Any] | None) -> dict[str, int] | None:

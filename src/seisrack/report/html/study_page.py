@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from seisrack import __version__
+from seisrack.jsonable import read_json_object
 from seisrack.report.html import figures as F
 from seisrack.report.html.page import _figure
 from seisrack.report.html.style import CSS
@@ -55,12 +56,9 @@ PEAK_LABELS = {"peak_sliding_max_m": "peak pallet sliding", "n_fall": "pallets a
 
 
 def read_study_json(out_dir: str | os.PathLike[str]) -> dict[str, Any] | None:
-    """``DIR/study.json`` (the study as given and its run table), or None if absent/unreadable."""
-    try:
-        doc = json.loads((Path(out_dir) / "study.json").read_text())
-    except (OSError, ValueError):
-        return None
-    return doc if isinstance(doc, dict) and doc else None
+    """``DIR/study.json`` (the study as given and its run table), or None if absent/unreadable
+    (the studies' own reader is this one; the report may not import the studies)."""
+    return read_json_object(Path(out_dir) / "study.json")
 
 
 def _records_html(study: dict[str, Any], toml: dict[str, Any]) -> str:
