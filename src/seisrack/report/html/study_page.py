@@ -56,8 +56,9 @@ PEAK_LABELS = {"peak_sliding_max_m": "peak pallet sliding", "n_fall": "pallets a
 
 
 def read_study_json(out_dir: str | os.PathLike[str]) -> dict[str, Any] | None:
-    """``DIR/study.json`` (the study as given and its run table), or None if absent/unreadable
-    (the studies' own reader is this one; the report may not import the studies)."""
+    """``DIR/study.json`` (the study as given and its run table), or None if absent/unreadable.
+    Read by :func:`seisrack.jsonable.read_json_object`, as the studies read it: the report may
+    not import the studies."""
     return read_json_object(Path(out_dir) / "study.json")
 
 
