@@ -73,14 +73,38 @@ def _ramp(t):
     return np.where(t < 0.5, np.sin(np.pi * np.minimum(t, 0.5)) ** 2, 1.0)
 
 
-def test_stiff_rack_two_components_matches_block_reference():
+def _stiff_one_pallet():  # noqa: ANN202
     d = _one_level(0.35, 50e-6)
     scale = 1e5  # members and joints 1e5 times stiffer: first period about 1.5 ms
     d["material"]["E"] *= scale
     d["connections"] = {k: v * scale for k, v in d["connections"].items()}
     d["damping"] = {"kind": "stiffness", "ratio": 0.02, "period": "first"}
     d["pallets"] = [{**d["pallets"][0], "mu_static": 0.35, "mu_dynamic": 0.3}]
-    model = compile_rack(rack_from_dict(d))
+    return compile_rack(rack_from_dict(d))
+
+
+def test_every_direction_held_runs_on_both_backends():
+    """At dt = 1 ms every basis direction of the stiff rack is held quasi-statically, so the
+    kernel integrates none: its check for a non-finite state read ``q[0]`` of an empty array
+    (an IndexError in the pure-Python twin; in the compiled kernel a read past the array, and
+    the run stopped now and then as "non-finite", once in a fresh-clone CI). Both backends
+    now run, and agree."""
+    model = _stiff_one_pallet()
+    dt = 0.001
+    t = np.arange(0.0, 1.5 + dt / 2, dt)
+    rec = combine(Record(_ramp(t) * ax_fn(t), dt, name="x"),
+                  Record(_ramp(t) * az_fn(t), dt, name="z"))
+    py = run_rack(model, rec, backend="python")
+    nb = run_rack(model, rec, backend="numba")
+    assert py.history.basis["quasi_static"] == py.history.basis["size"] > 0
+    assert py.history.status == nb.history.status == "ok"
+    assert py.pallet_peak_sliding()[0] > 1e-3  # it slides
+    np.testing.assert_allclose(py.pallet_sliding, nb.pallet_sliding, rtol=0,
+                               atol=1e-9 * np.abs(nb.pallet_sliding).max())
+
+
+def test_stiff_rack_two_components_matches_block_reference():
+    model = _stiff_one_pallet()
 
     def ax(t):
         return _ramp(t) * ax_fn(t)

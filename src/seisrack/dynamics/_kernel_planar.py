@@ -71,6 +71,19 @@ _SPAN = 1e-6
 
 
 @_JIT
+def _finite_state(T0, S0):
+    """Whether the state is finite, read at its first structural coordinate, or at its first
+    pallet's when the kernel integrates no direction (every one held quasi-statically: reading
+    ``T0[0, 0]`` there read past an empty array, and the run stopped at random as
+    "non-finite")."""
+    if T0.shape[1] > 0:
+        return np.isfinite(T0[0, 0])
+    if S0.shape[1] > 0:
+        return np.isfinite(S0[0, 0])
+    return True
+
+
+@_JIT
 def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_state, S_state,
                stuck, dirn, S, A, fac, t_offset, max_events, max_substeps,
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
@@ -378,7 +391,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
             _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax,
                         out_energy)
         k_done = k + 1
-        if not np.isfinite(T0[0, 0]):
+        if not _finite_state(T0, S0):
             status = STATUS_NONFINITE
             break
     if n_ev > max_events and status == STATUS_OK:
