@@ -69,3 +69,15 @@ def test_numba_python_parity(dense_damping, method):
     for key, b in slow.energy.items():
         a = fast.energy[key]
         assert np.max(np.abs(a - b)) <= rtol * max(float(np.max(np.abs(b))), 1e-300), key
+    # the work counters: the same work on both backends (the Newmark kernel's; none for the
+    # exact one), every step a trial, every trial at least one solve
+    assert fast.work == slow.work
+    if method == "newmark":
+        w = fast.work
+        assert set(w) == {"trials", "newton_iterations", "factorisations", "location_trials"}
+        assert w["trials"] >= N_STEPS + w["location_trials"]
+        assert w["newton_iterations"] >= w["trials"]
+        assert 1 <= w["factorisations"] <= w["newton_iterations"]
+        assert w["location_trials"] > 0
+    else:
+        assert fast.work == {}

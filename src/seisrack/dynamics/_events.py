@@ -133,6 +133,38 @@ def _propose(br, stuck, e_lo, e_hi, tolF, mus, N1, hrem, dt):
 
 
 @_JIT
+def _first_trial(stuck, sig, e_lo, e_hi, tolF, mus, N1, arel, hrem):
+    """First trial fraction of a location on a line (bracket [0, 1]): the earliest root of the
+    violated event functions, aimed as :func:`_propose3` aims (the middle of the acceptance
+    window). A sliding slider's stop function ``-sig s`` is the root of the quadratic through
+    its value and slope at the start and its value at the end: its slope is ``-sig arel hrem``,
+    ``arel`` its acceleration relative to its support at the start of the sub-step, and the
+    regula falsi's straight line through the two ends often misses a stop by a good part of
+    the step. A stuck slider's (its force) is that straight line. As the planar kernel's
+    ``_first_guess`` (``docs/theory/planar_friction.md`` §3). Measured: 16 % fewer location
+    trials on a 400-pallet warehouse rack with bilinear connections, the same on the paper rack.
+    """
+    th = 2.0
+    for j in range(stuck.shape[0]):
+        if e_hi[j] <= tolF[j]:
+            continue
+        tgt = tolF[j] + 0.5 * (_conv_limit(stuck[j], mus[j], N1[j], tolF[j]) - tolF[j])
+        f0 = min(e_lo[j] - tgt, 0.0)
+        f1 = e_hi[j] - tgt
+        tj = -f0 / (f1 - f0)
+        if not stuck[j]:
+            d = -sig[j] * arel[j] * hrem
+            a = f1 - f0 - d
+            disc = d * d - 4.0 * a * f0
+            if d > 0.0 and disc >= 0.0:
+                tq = -2.0 * f0 / (d + np.sqrt(disc))
+                if 0.0 < tq < 1.0:
+                    tj = tq
+        th = min(th, tj)
+    return min(max(th, 1e-6), 1.0 - 1e-6)
+
+
+@_JIT
 def _keep_old(br, e_try, tolF, e_lo, e_hi, e_old):
     """Before :func:`_accept_values`: copy the bracket end the trial will replace into
     ``e_old``; returns its fraction (the third point of :func:`_propose3`)."""

@@ -52,6 +52,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _detect,
         _event_buffers,
         _finish,
+        _first_trial,
         _init_sliders,
         _interp,
         _propose,
@@ -76,7 +77,7 @@ def run_kernel(
     q_init, qd_init, resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
     track_energy, max_events, max_substeps,
     out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy, out_hm,
-    ev_time, ev_slider, ev_kind,
+    ev_time, ev_slider, ev_kind, stats,
 ):
     """Integrate ``n_steps = ag.shape[0] - 1`` steps. Returns (status, n_events, n_substeps).
 
@@ -95,6 +96,8 @@ def run_kernel(
     hst (n_h, HYST_NSTATE) law, parameters and committed state; out_hm (n_t, n_h) moments.
     out_energy columns: input, kinetic, strain (with the hinges' correction work, so that the
     column is the structure's whole internal work), damping, friction dissipation (cumulative).
+    ``stats`` (int64, 4) accumulates the work: trial steps, Newton iterations, factorisations of
+    the Newton core, location trials (as the planar kernel's).
     """
     n = kd.shape[0]
     m = mass.shape[0]
@@ -181,7 +184,7 @@ def run_kernel(
                 hrem, kd, cd, Cq, diag, D, DHh, mass, mus, mud, rate, hth0,
                 hk, hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
                 stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
-                n_cfg, Kc, piv, om, cmeta)
+                n_cfg, Kc, piv, om, cmeta, stats)
             if st_tr != STATUS_OK:
                 status = st_tr
                 break
@@ -198,6 +201,13 @@ def run_kernel(
                     th = _propose(br, stuck, e_lo, e_hi, tolF, mus, N[step + 1], hrem, dt)
                     if th < 0.0:
                         break
+                    if _it == 0:  # the sliders' accelerations relative to their supports
+                        _mv(P, qdd, wk_v)
+                        for j in range(m):
+                            wk_v[j] = wdd[j] - wk_v[j]
+                        th = _first_trial(stuck, sig, e_lo, e_hi, tolF, mus, N[step + 1], wk_v,
+                                          hrem)
+                    stats[3] += 1
                     ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
                     hsub = th * hrem
                     _dh_into(kd, cd, Cq, diag, hsub, D, DH[1])
@@ -206,7 +216,7 @@ def run_kernel(
                         hsub, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0, hk, hlaw,
                         hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e, stuck,
                         sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
-                        n_cfg, Kc, piv, om, cmeta)
+                        n_cfg, Kc, piv, om, cmeta, stats)
                     if st_tr != STATUS_OK:
                         status = st_tr
                         break

@@ -159,6 +159,7 @@ def _nl_trial(
     h, kd, cd, Cq, diag, D, DH, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
     q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, Ms_key, n_cfg, Kc, piv, om, cmeta,
+    stats,
 ):
     """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
 
@@ -167,7 +168,8 @@ def _nl_trial(
     ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration mass of the stuck pallets
     (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc`` (2, n, n), ``piv`` (n,),
     ``om`` (n_h,) and ``cmeta`` (3,) the Newton core's cache (zeros at the start of a run),
-    kept across calls.
+    kept across calls. ``stats`` counts the trial (0), its Newton iterations (1) and
+    factorisations of the core (2).
 
     The Newton matrix is ``J = E + R_D D K̂⁻¹ Dᵀ Z`` (diagonal ``E``, ``R_D``, ``Z``: a stuck
     pallet's row holds ``(h/2)/m_j`` and ``2/h``; a sliding pallet's ``1`` and its friction's
@@ -223,6 +225,7 @@ def _nl_trial(
             smooth = True
     status = STATUS_NEWTON
     done = False
+    stats[0] += 1
     for it in range(_NEWTON_MAX):
         same = it > 0 and not smooth
         for i in range(nh):
@@ -272,6 +275,7 @@ def _nl_trial(
         changed = _core_weights(D[m:], zp[:nh], om, Kc, cmeta)
         if fresh or changed or cmeta[0] != h or cmeta[2] != n_cfg:
             ok = _core_factor(kd, cd, Cq, diag, h, Ms_key, Kc, sw[:m], D, piv)
+            stats[2] += 1
             cmeta[0] = h if ok and not fresh else 0.0
             cmeta[2] = n_cfg
             if not ok:
@@ -285,6 +289,7 @@ def _nl_trial(
             R[a] = y[a]
         _mtv(D, R, u)
         _core_solve(Kc, piv, u)
+        stats[1] += 1
         _mv(D, u, g)
         step = 0.5 if it >= _NEWTON_DAMPED else 1.0
         conv = True

@@ -108,6 +108,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
     stuck_state = np.ones(m, dtype=np.bool_)
     sig_state = np.ones(m)
     e_state = np.zeros(4)
+    stats = np.zeros(4, dtype=np.int64)  # the Newmark kernel's work counters
     status, n_ev, n_sub, n_cfg = 0, 0, 0, 0
     if use_exact:
         a1 = _stiffness_proportional(w2, cd)
@@ -142,6 +143,7 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
                     float(dt), ag[rows], np.ascontiguousarray(ser @ pat), N, qs, qds,
                     start > 0, w_state, wd_state, stuck_state, sig_state, e_state,
                     start * float(dt), bool(track_energy), left, _MAX_SUBSTEPS, *outs, *ev,
+                    stats,
                 )
             n_ev += int(ne)
             n_sub += int(ns)
@@ -200,6 +202,9 @@ def run_line(M, C, K, sliders: Sliders, *, dt: float, n_steps: int, ag: np.ndarr
         hinge_moment=khm,
         hinge_operator=Q,
         hinge_rotation0=h_th0,
+        work={} if use_exact else dict(zip(
+            ("trials", "newton_iterations", "factorisations", "location_trials"),
+            (int(x) for x in stats), strict=True)),
     )
 
 

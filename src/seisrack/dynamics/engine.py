@@ -45,7 +45,7 @@ from seisrack.dynamics.sliders import PlanarSliders, Sliders
 SCHEME_FEATURES = {
     "line": ("ground motion", "vertical motion", "applied forces", "initial state",
              "exact propagators", "Newmark", "nonlinear hinges", "velocity-dependent friction",
-             "energy balance", "reduced basis", "chunks"),
+             "energy balance", "reduced basis", "chunks", "work counters (Newmark)"),
     "planar": ("ground motion in two directions", "vertical motion", "Newmark",
                "nonlinear hinges", "energy balance", "reduced basis", "chunks", "work counters"),
 }

@@ -76,6 +76,8 @@ class TimeHistory:
     Here ``n_t`` counts the *kept* samples: with ``simulate(save_every=k)`` they are the steps
     listed in ``sample_index`` (every k-th and the last), at times ``t``. ``basis`` describes
     the basis ``phi`` (full, or reduced with its cut-off), see :mod:`seisrack.dynamics.basis`.
+    ``work``: the kernel's work counters (the Newmark kernels': trial steps, Newton
+    iterations, factorisations, location trials; empty for the exact kernel).
     """
 
     t: np.ndarray
