@@ -11,7 +11,13 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_planar_step.py``
     _chol  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    from seisrack.dynamics._events import _JIT, KIND_REVERSE, KIND_SLIP, KIND_STICK
+    from seisrack.dynamics._events import (
+        _JIT,
+        KIND_REVERSE,
+        KIND_SLIP,
+        KIND_STICK,
+        _root_on_quadratic,
+    )
     from seisrack.dynamics._lapack import _chol, _chol_solve
     from seisrack.dynamics._planar_contact import _released_forces
     from seisrack.dynamics._planar_step import _s_update
@@ -52,13 +58,7 @@ def _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P, qdd0, ag0, hre
             d = mud[p] * N0[p] / mass[p]
             for c in range(2):
                 d += dirn[jx + c] * (ag0[c] + np.dot(P[jx + c], qdd0))
-            d *= hrem
-            a = f1 - f0 - d
-            disc = d * d - 4.0 * a * f0
-            if d > 0.0 and disc >= 0.0:
-                tq = -2.0 * f0 / (d + np.sqrt(disc))
-                if 0.0 < tq < 1.0:
-                    tj = tq
+            tj = _root_on_quadratic(f0, f1, d * hrem, tj)
         th = min(th, tj)
     return min(max(th, 1e-6), 1.0 - 1e-6)
 
