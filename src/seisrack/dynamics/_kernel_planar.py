@@ -103,7 +103,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     lam, s, vn; ``stuck``, ``dirn``; ``S`` (r + 2, r): the stuck pallets' mass (see
     ``_s_update``); ``A`` (r, r) and ``fac`` (1,): the last factorised Newton matrix and its
     step length, -1 for none (see ``_trial``). ``stats`` (int64, 4) accumulates the trial
-    steps, Newton iterations, Cholesky factorisations and location trials. Outputs per step
+    steps, Newton iterations, Cholesky factorisations (of the step's Newton matrix and of
+    ``_decide``'s configuration mass) and location trials. Outputs per step
     (n_t rows): q, qd, qdd, u (sliding displacement w - P q), v (relative velocity), lam
     (friction force on the pallet), stuck.
 
@@ -204,7 +205,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
             for i in range(r):
                 pz[i] -= fa[i]
         _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, N[0], stuck, dirn,
-                cand, forced, A, pe, forced)
+                cand, forced, A, pe, forced, stats)
         for p in range(m):
             old_stuck[p] = True  # "slip" at t = 0 for pallets released at once
             cand[p] = False
@@ -361,7 +362,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                     for i in range(r):
                         pz[i] -= fb[i]
                 _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pz, Ne, stuck, dirn,
-                        cand, forced, A, W[10, :r], frozen)
+                        cand, forced, A, W[10, :r], frozen, stats)
                 fac[0] = -1.0
                 for p in range(m):
                     # a pallet that reached zero velocity and slides on has turned

@@ -65,7 +65,7 @@ def _first_guess(stuck, dirn, e_lo, e_hi, tolF, mass, mud, N0, P, qdd0, ag0, hre
 
 @_JIT
 def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, cand, forced,
-            A, base, frozen):
+            A, base, frozen, stats):
     """Contact state at an instant and consistent accelerations (active set).
 
     ``cand``: pallets at zero relative velocity to be decided (they stick when the force that
@@ -76,7 +76,8 @@ def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, 
     others (an all-at-once release chattered, each pallet re-sticking at once). Updates
     ``stuck``, ``dirn`` and ``S`` (the stuck pallets' mass); writes qdd, wdd and lam.
     ``frozen`` pallets keep their state (see ``_CHATTER``). Damping: ``cd`` its diagonal,
-    ``Co`` the rest or (0, 0) (see ``_trial``).
+    ``Co`` the rest or (0, 0) (see ``_trial``). ``stats[2]`` counts the factorisations of
+    I + S (one, and one more after each release or re-stick).
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -95,6 +96,7 @@ def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, 
                 A[i, k] = S[i, k]
             A[i, i] += 1.0
         _chol(A)
+        stats[2] += 1
         n_rel = 0
         for p in range(m):
             if zr[p] and not stuck[p]:
