@@ -201,12 +201,24 @@ def _secant(a, fa, b, fb):
 
 
 @_JIT
+def _iqi(a, fa, b, fb, c, fc):
+    """Root of the inverse quadratic through three points (theta as a quadratic in the
+    function's value, evaluated at 0), or -1 when two values coincide."""
+    if fa == fb or fa == fc or fb == fc:
+        return -1.0
+    return (a * fb * fc / ((fa - fb) * (fa - fc)) + b * fa * fc / ((fb - fa) * (fb - fc))
+            + c * fa * fb / ((fc - fa) * (fc - fb)))
+
+
+@_JIT
 def _propose3(br, stuck, e_lo, e_hi, e_old, th_old, tolF, mus, N1, hrem, dt, span_tol):
     """:func:`_propose` with a third point: the values ``e_old`` at ``th_old`` (the bracket
-    end the last trial replaced; none when ``th_old < 0``). Each violated function's root is
-    then the secant through the third point and the bracket end on the same side of the root,
-    when it falls inside the bracket, else the Illinois estimate. The location also ends
-    when the bracket is shorter than ``span_tol`` dt."""
+    end the last trial replaced; none when ``th_old < 0``). A stuck slider's onset function
+    is smooth across its root: its root is then the inverse quadratic through the three points
+    (:func:`_iqi`, order about 1.84); a sliding one's stop function may have a kink at its
+    root: its root is the secant through the third point and the bracket end on the same side
+    of the root. Either only when it falls inside the bracket, else the Illinois estimate.
+    The location also ends when the bracket is shorter than ``span_tol`` dt."""
     theta_lo = br[0]
     theta_hi = br[1]
     th = theta_hi
@@ -222,15 +234,22 @@ def _propose3(br, stuck, e_lo, e_hi, e_old, th_old, tolF, mus, N1, hrem, dt, spa
             frac = -elo / den if den > 0.0 else 0.0
             tj = theta_lo + frac * (theta_hi - theta_lo)
             if th_old >= 0.0 and br[4] < 3.0:
-                # secant through the third point and the bracket end on its side of the
-                # root: both on one smooth branch when the function has a kink at its root
-                # (a pallet that stops: sliding on one side, stopping inside the step on the
-                # other), where any interpolation across the root converges only linearly
                 fo = e_old[j] - tgt
-                if fo > 0.0:
-                    ti = _secant(theta_hi, e_hi[j] - tgt, th_old, fo)
-                else:
-                    ti = _secant(theta_lo, e_lo[j] - tgt, th_old, fo)
+                ti = -1.0
+                if stuck[j]:
+                    # a slip onset's function (|lam| - mu_s N) is smooth across its root:
+                    # inverse quadratic interpolation through the three points
+                    ti = _iqi(theta_lo, e_lo[j] - tgt, theta_hi, e_hi[j] - tgt, th_old, fo)
+                if not theta_lo < ti < theta_hi:
+                    # secant through the third point and the bracket end on its side of the
+                    # root: both on one smooth branch when the function has a kink at its
+                    # root (a pallet that stops: sliding on one side, stopping inside the
+                    # step on the other), where any interpolation across the root converges
+                    # only linearly
+                    if fo > 0.0:
+                        ti = _secant(theta_hi, e_hi[j] - tgt, th_old, fo)
+                    else:
+                        ti = _secant(theta_lo, e_lo[j] - tgt, th_old, fo)
                 if theta_lo < ti < theta_hi:
                     tj = ti
             if tj < th or jmin < 0:
