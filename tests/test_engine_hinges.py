@@ -181,8 +181,12 @@ def test_rack_reduced_basis_keeps_the_full_peaks():
 
 
 def test_rack_sliding_converges_with_yielding_hinges():
-    """Peak pallet sliding and peak hinge rotation against a run at dt/16: fitted order ≥ 1.8
-    (issue 22; measured 1.89 and 1.92)."""
+    """Peak pallet sliding and peak hinge rotation against a run at 0.078 ms, dt from 5 ms
+    (the default) to 0.3125 ms: fitted order ≥ 1.8 (issue 22; measured 1.90 and 1.87 with
+    the composite steps after events, 1.94 and 1.92 with the trapezoidal rule throughout).
+    At 10 ms the composite steps' errors are lower than the trapezoidal rule's (1.2 % against
+    1.5 % of the peak sliding, 0.53 % against 0.94 % of the peak rotation): the fit starts at
+    5 ms, where both schemes are in their asymptotic range."""
     model = _nonlinear_rack(0.5)
     rec = _record(8.0, 2.0)
     h = rack_hinges(model)
@@ -193,13 +197,13 @@ def test_rack_sliding_converges_with_yielding_hinges():
         return np.array([np.max(np.abs(r.pallet_sliding)),
                          np.max(np.abs(r.hinges.rotation))])
 
-    dts = [0.01 / 2**k for k in range(4)]
-    ref = peaks(dts[-1] / 8)
+    dts = [0.005 / 2**k for k in range(5)]
+    ref = peaks(0.01 / 128)
     errs = np.array([np.abs(peaks(dt) - ref) / ref for dt in dts])
     for col in range(2):
         order = np.polyfit(np.log(dts), np.log(errs[:, col]), 1)[0]
         assert order >= 1.8, (col, order, errs[:, col])
-    assert np.all(errs[-1] < 1e-3)
+    assert np.all(errs[-1] < 1e-4)
 
 
 def test_bad_hinges_are_refused():

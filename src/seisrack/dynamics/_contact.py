@@ -4,10 +4,10 @@
 ``_consistent`` decides which sliders stick or slide at an instant (start of the run, or a
 located event) and computes the consistent accelerations, in the structure's coordinates with
 the stuck sliders' configuration mass (shared with the exact kernel); ``_accel_fixed``
-recomputes the accelerations from equilibrium for given slider forces; ``_newmark_end``
-completes a trial step (linear ``_trial`` and nonlinear ``_nl_trial``) once its generalized
-forces are known. Loaded before ``_kernel_hinge.py`` and ``_kernel.py`` into the numba
-namespace (see ``_kernel_numba.py``); ``docs/theory/stick_slip_engine.md`` §3 and §5.
+recomputes the accelerations from equilibrium for given slider forces; ``_step_end``
+completes a trial step (``_nl_trial``) once its generalized forces are known. Loaded before
+``_kernel_hinge.py`` and ``_kernel.py`` into the numba namespace (see ``_kernel_numba.py``);
+``docs/theory/stick_slip_engine.md`` §3 and §5.
 """
 
 # ruff: noqa: N803, N806  (matrix names follow the equations)
@@ -23,27 +23,29 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
 
 
 @_JIT
-def _newmark_end(h, DH, y, qhat, q0, qd0, qdd0, P, mass, ag1, lam1, w0, wd0, wdd0, stuck,
-                 q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vn):
-    """End state of an average-acceleration step of length ``h``: Δq = q̂ − (DH)ᵀ y (``y``: the
-    slider forces, then any hinge corrections; ``DH`` = [P; Q] K̂⁻¹), the Newmark updates of
-    q̇, q̈, and the sliders' (w, ẇ, ẅ) under the forces ``lam1``; a stuck slider gets exactly
-    its support's velocity (removes round-off drift). ``f`` (n,), ``vn`` (m,) are scratch."""
+def _step_end(sc, kq, kw, DH, y, qhat, q0, P, mass, ag1, lam1, stuck,
+              q1, qd1, qdd1, w1, wd1, wdd1, s1, f, vn):
+    """End state of an implicit (sub)step once its generalized forces are known: Δq = q̂ −
+    (DH)ᵀ y (``y``: the slider forces, then any hinge corrections; ``DH`` = [P; Q] K̂⁻¹), the
+    step's relations ``q̈₁ = a Δq + A``, ``q̇₁ = v Δq + V`` (``sc`` = [a, v, β, κ], ``kq`` =
+    [A; V], ``_kernel_stage.py``), and the sliders' ``ẅ₁ = λ₁/m − a_g``, ``ẇ₁ = β λ₁/m + W``,
+    ``w₁ = X + κ ẇ₁`` (``kw`` = [W; X]); a stuck slider gets exactly its support's velocity
+    (removes round-off drift). ``f`` (n,), ``vn`` (m,) are scratch."""
     n = q0.shape[0]
-    c0 = 4.0 / (h * h)
-    c1 = 4.0 / h
-    c2 = 2.0 / h
+    a = sc[0]
+    v = sc[1]
     _mtv(DH, y, f)
     for i in range(n):
         dq = qhat[i] - f[i]
         q1[i] = q0[i] + dq
-        qd1[i] = c2 * dq - qd0[i]
-        qdd1[i] = c0 * dq - c1 * qd0[i] - qdd0[i]
+        qd1[i] = v * dq + kq[1, i]
+        qdd1[i] = a * dq + kq[0, i]
     _mv(P, qd1, vn)
     for j in range(mass.shape[0]):
-        wdd1[j] = -ag1 + lam1[j] / mass[j]
-        wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
-        w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
+        r = lam1[j] / mass[j]
+        wdd1[j] = r - ag1
+        wd1[j] = sc[2] * r + kw[0, j]
+        w1[j] = kw[1, j] + sc[3] * wd1[j]
         if stuck[j]:
             wd1[j] = vn[j]
         s1[j] = wd1[j] - vn[j]

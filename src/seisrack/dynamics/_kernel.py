@@ -68,14 +68,23 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _mu_now,
         _nl_trial,
     )
-    from seisrack.dynamics._linalg import _damp_mul, _dh_into, _mv
+    from seisrack.dynamics._kernel_stage import (
+        GAMMA,
+        _algorithmic,
+        _composite,
+        _hinge_commit2,
+        _stage_energy,
+        _trap_coefs,
+    )
+    from seisrack.dynamics._linalg import _dh_into, _mv
+
 
 
 @_JIT
 def run_kernel(
     kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hth0, hk, hlaw, hpar, hst, dt, ag, pext, N,
     q_init, qd_init, resume, w_state, wd_state, stuck_state, sig_state, e_state, t_offset,
-    track_energy, max_events, max_substeps,
+    track_energy, max_events, max_substeps, comp_steps,
     out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy, out_hm,
     ev_time, ev_slider, ev_kind, stats,
 ):
@@ -107,7 +116,7 @@ def run_kernel(
     D[:m] = P
     D[m:] = Q
     DH = np.empty((2, m + nh, n))  # D K̂⁻¹ of the regular step, and of a shorter one
-    _dh_into(kd, cd, Cq, diag, dt, D, DH[0])
+    _dh_into(kd, cd, Cq, diag, 2.0 / dt, D, DH[0])
     # state at the start of the (sub)step: T0 rows q, qd, qdd; S0 rows w, wd, lam, s, wdd
     T0 = np.zeros((3, n))
     T0[0] = q_init
@@ -117,9 +126,17 @@ def run_kernel(
         5, resume, P, q, qd, w_state, wd_state, stuck_state, sig_state, e_state)
     w, wd, lam, s0, wdd = S0[0], S0[1], S0[2], S0[3], S0[4]
     E_z = e_state[3] if resume else 0.0
+    E_alg = e_state[4] if resume else 0.0  # taken out by the composite steps (_algorithmic)
+    n_comp = int(e_state[5]) if resume else 0  # composite steps still to take
     Wh = np.zeros((4, nh))  # hinge moments, corrections (committed), and trial copies
     hM, hz, hM_t, hz_t = Wh[0], Wh[1], Wh[2], Wh[3]
     hst_t = hst.copy()
+    hst_m = hst.copy()  # the hinges at a composite step's mid state
+    hz_m = np.zeros(nh)
+    sc = np.empty(4)  # the step's relations (_kernel_stage.py)
+    kq = np.empty((2, n))
+    kw = np.empty((2, m))
+    ea = np.zeros(3)  # energy increments of a sub-step: input, damping, friction
     wn = np.empty((4, n))  # scratch of the trial step, and its Newton core's cache
     wx = np.empty((12, m + nh))
     Kc = np.zeros((2, n, n))
@@ -150,24 +167,27 @@ def run_kernel(
     status = STATUS_OK
     st_tr = STATUS_OK
     # trial end state and its copy at the bracket's hi end
-    T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(3, n, 5, m)
+    # (rows 3-5 and 5-9: a composite step's mid state)
+    T1, S1, Tb, Sb, br, e_lo, e_hi, e_try, tolF, old_stuck, old_sig = _event_buffers(6, n, 10, m)
     q1, qd1, qdd1 = T1[0], T1[1], T1[2]
     w1, wd1, lam1, s1, wdd1 = S1[0], S1[1], S1[2], S1[3], S1[4]
     n_sub_total = 0
-    Wn = np.empty((4, n))  # scratch
-    pe0, pe1, tmpn, tmpn2 = Wn[0], Wn[1], Wn[2], Wn[3]
-    Wm = np.empty((3, m))
-    wk_v, vn0, N_e = Wm[0], Wm[1], Wm[2]
+    Wn = np.empty((6, n))  # scratch
+    pe0, pe1, tmpn, tmpn2, pe_m, pe_e = Wn[0], Wn[1], Wn[2], Wn[3], Wn[4], Wn[5]
+    Wm = np.empty((4, m))
+    wk_v, vn0, N_e, N_m = Wm[0], Wm[1], Wm[2], Wm[3]
 
     _write_output(0, q, qd, qdd, w, wd, lam, stuck, mass, kd, track_energy, E_in, E_damp,
                   E_fric, out_q, out_qd, out_qdd, out_w, out_wd, out_lam, out_stuck, out_energy)
     out_energy[0, 2] += E_z
+    out_energy[0, 5] = E_alg
     out_hm[0, :] = hM
     for step in range(n_t - 1):
         tau = 0.0  # fraction of the step already integrated
         n_sub = 0  # sub-steps taken in this step
         while True:
             full = tau == 0.0
+            comp = n_comp > 0
             hrem = (1.0 - tau) * dt
             if n_sub >= max_substeps:
                 status = STATUS_SUBSTEP_LIMIT
@@ -176,15 +196,24 @@ def run_kernel(
             for i in range(n):
                 pe1[i] = pext[step + 1, i]
             ag1 = ag[step + 1]
-            if not full:
-                _dh_into(kd, cd, Cq, diag, hrem, D, DH[1])
-            DHh = DH[0] if full else DH[1]
-            hz_t[:] = hz
-            st_tr = _nl_trial(
-                hrem, kd, cd, Cq, diag, D, DHh, mass, mus, mud, rate, hth0,
-                hk, hlaw, hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag1, pe1, N[step + 1],
-                stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
-                n_cfg, Kc, piv, om, cmeta, stats)
+            if comp:
+                ag_m = _sample(ag, pext, N, step, tau + GAMMA * (1.0 - tau), pe_m, N_m)
+                st_tr = _composite(
+                    hrem, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0, hk, hlaw,
+                    hpar, hst, hst_m, hst_t, T0, S0, T1, S1, ag_m, pe_m, N_m, ag1, pe1,
+                    N[step + 1], stuck, sig, hz, hM_t, hz_t, hz_m, wn, wx, Ms_key, n_cfg, Kc,
+                    piv, om, cmeta, stats, sc, kq, kw)
+            else:
+                _trap_coefs(hrem, w, qd, qdd, wd, wdd, ag1, sc, kq, kw)
+                if not full:
+                    _dh_into(kd, cd, Cq, diag, sc[1], D, DH[1])
+                DHh = DH[0] if full else DH[1]
+                hz_t[:] = hz
+                st_tr = _nl_trial(
+                    sc, kq, kw, kd, cd, Cq, diag, D, DHh, mass, mus, mud,
+                    rate, hth0, hk, hlaw, hpar, hst, hst_t, q, lam, ag1, pe1, N[step + 1],
+                    stuck, sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx,
+                    Ms_key, n_cfg, Kc, piv, om, cmeta, stats)
             if st_tr != STATUS_OK:
                 status = st_tr
                 break
@@ -208,15 +237,25 @@ def run_kernel(
                         th = _first_trial(stuck, sig, e_lo, e_hi, tolF, mus, N[step + 1], wk_v,
                                           hrem)
                     stats[3] += 1
-                    ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), tmpn, N_e)
+                    ag_e = _sample(ag, pext, N, step, tau + th * (1.0 - tau), pe_e, N_e)
                     hsub = th * hrem
-                    _dh_into(kd, cd, Cq, diag, hsub, D, DH[1])
-                    hz_t[:] = hz
-                    st_tr = _nl_trial(
-                        hsub, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0, hk, hlaw,
-                        hpar, hst, hst_t, q, qd, qdd, w, wd, wdd, lam, ag_e, tmpn, N_e, stuck,
-                        sig, q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
-                        n_cfg, Kc, piv, om, cmeta, stats)
+                    if comp:
+                        ag_m = _sample(ag, pext, N, step, tau + GAMMA * th * (1.0 - tau),
+                                       pe_m, N_m)
+                        st_tr = _composite(
+                            hsub, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0, hk,
+                            hlaw, hpar, hst, hst_m, hst_t, T0, S0, T1, S1, ag_m, pe_m, N_m,
+                            ag_e, pe_e, N_e, stuck, sig, hz, hM_t, hz_t, hz_m, wn, wx, Ms_key,
+                            n_cfg, Kc, piv, om, cmeta, stats, sc, kq, kw)
+                    else:
+                        _trap_coefs(hsub, w, qd, qdd, wd, wdd, ag_e, sc, kq, kw)
+                        _dh_into(kd, cd, Cq, diag, sc[1], D, DH[1])
+                        hz_t[:] = hz
+                        st_tr = _nl_trial(
+                            sc, kq, kw, kd, cd, Cq, diag, D, DH[1], mass, mus, mud, rate, hth0,
+                            hk, hlaw, hpar, hst, hst_t, q, lam, ag_e, pe_e, N_e, stuck, sig,
+                            q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM_t, hz_t, wn, wx, Ms_key,
+                            n_cfg, Kc, piv, om, cmeta, stats)
                     if st_tr != STATUS_OK:
                         status = st_tr
                         break
@@ -235,30 +274,35 @@ def run_kernel(
                     pe1[i] = _interp(pext[step, i], pext[step + 1, i], tau_end)
                 ag_a = _interp(ag[step], ag[step + 1], tau)
                 ag_b = _interp(ag[step], ag[step + 1], tau_end)
-                for i in range(n):
-                    tmpn[i] = qd[i] + qd1[i]
-                _damp_mul(cd, Cq, diag, tmpn, tmpn2)
-                dq_in = 0.0
-                dd = 0.0
-                for i in range(n):
-                    dqi = q1[i] - q[i]
-                    dq_in += dqi * 0.5 * (pe0[i] + pe1[i])
-                    dd += dqi * 0.5 * tmpn2[i]
-                for i in range(n):
-                    tmpn[i] = q1[i] - q[i]
-                _mv(P, tmpn, wk_v)
-                for j in range(m):
-                    dwj = w1[j] - w[j]
-                    dq_in -= mass[j] * dwj * 0.5 * (ag_a + ag_b)
-                    E_fric -= 0.5 * (lam[j] + lam1[j]) * (dwj - wk_v[j])
-                E_in += dq_in
-                E_damp += dd
-            if nh > 0:
+                ea[:] = 0.0
+                if comp:  # two stages, each a trapezoid of its end values
+                    tmid = tau + GAMMA * (tau_end - tau)
+                    for i in range(n):
+                        pe_m[i] = _interp(pext[step, i], pext[step + 1, i], tmid)
+                    ag_m = _interp(ag[step], ag[step + 1], tmid)
+                    _stage_energy(q, qd, T1[3], T1[4], w, S1[5], lam, S1[7], pe0, pe_m, ag_a,
+                                  ag_m, P, mass, cd, Cq, diag, tmpn, tmpn2, wk_v, ea)
+                    _stage_energy(T1[3], T1[4], q1, qd1, S1[5], w1, S1[7], lam1, pe_m, pe1,
+                                  ag_m, ag_b, P, mass, cd, Cq, diag, tmpn, tmpn2, wk_v, ea)
+                    E_alg += _algorithmic(T1[3], T1[4], T1[5], q1, qd1, qdd1, S1[5], S1[6],
+                                          S1[9], w1, wd1, wdd1, mass)
+                else:
+                    _stage_energy(q, qd, q1, qd1, w, w1, lam, lam1, pe0, pe1, ag_a, ag_b, P,
+                                  mass, cd, Cq, diag, tmpn, tmpn2, wk_v, ea)
+                E_in += ea[0]
+                E_damp += ea[1]
+                E_fric += ea[2]
+            if nh > 0 and comp:
+                E_z += _hinge_commit2(Q, hth0, hk, hlaw, hpar, hst, hst_m, hst_t, T1[3], q1,
+                                      hM, hz, hM_t, hz_t, hz_m)
+            elif nh > 0:
                 E_z += _hinge_commit(Q, hth0, hk, hlaw, hpar, hst, hst_t, q1, hM, hz, hM_t,
                                      hz_t, not any_ev)
-            T0[:] = T1
-            S0[:] = S1
+            T0[:] = T1[:3]
+            S0[:] = S1[:5]
             if tau_end >= 1.0:
+                if n_comp > 0:
+                    n_comp -= 1
                 if not full:
                     # a short final sub-step amplifies round-off in the Newmark acceleration
                     # update; restore accelerations from equilibrium (same forces lam)
@@ -279,6 +323,7 @@ def run_kernel(
             chg, n_rank1 = _cfg_update(P, mass, stuck, on_struct, key, Ms_key, n_rank1)
             if chg:
                 n_cfg += 1.0
+            n_comp = comp_steps
             n_ev = _record_events(old_stuck, old_sig, stuck, sig,
                                   t_offset + (step + tau_end) * dt, n_ev, max_events,
                                   ev_time, ev_slider, ev_kind)
@@ -289,10 +334,13 @@ def run_kernel(
                                E_in, E_damp, E_fric, out_q, out_qd, out_qdd, out_w, out_wd,
                                out_lam, out_stuck, out_energy)
         out_energy[step + 1, 2] += E_z
+        out_energy[step + 1, 5] = E_alg
         out_hm[step + 1, :] = hM
         if status != STATUS_OK:
             break
     status = _finish(status, n_ev, max_events, w, wd, stuck, sig, E_in, E_damp, E_fric,
                      w_state, wd_state, stuck_state, sig_state, e_state)
     e_state[3] = E_z
+    e_state[4] = E_alg
+    e_state[5] = n_comp
     return status, n_ev, n_sub_total

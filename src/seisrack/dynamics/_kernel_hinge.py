@@ -14,8 +14,9 @@ Formulation, in the structure's mass-orthonormal coordinates ``q`` (``u = Φ q``
   elastic stiffness ``k_i`` stays in the modal stiffness ``kd``; the law's moment ``M_i(θ_i)``
   enters as the correction ``z_i = M_i − k_i θ_i`` (zero while the hinge is elastic), applied
   as the generalized force ``Qᵀ z``;
-* end-of-step equilibrium of average-acceleration Newmark (β = 1/4, γ = 1/2):
-  ``K̂ Δq = r − Pᵀ λ₁ − Qᵀ z(θ₁)`` with ``K̂ = K + (2/h) C + (4/h²) I``;
+* end-of-step equilibrium of an implicit step, average-acceleration Newmark (β = 1/4, γ = 1/2)
+  or a stage of the composite step after an event (``_kernel_stage.py``):
+  ``K̂ Δq = r − Pᵀ λ₁ − Qᵀ z(θ₁)`` with ``K̂ = K + v C + v² I`` (``v = 2/h`` for Newmark);
 * unknowns ``x = [λ (m sliders), θ (n_h hinges)]``, residuals
   stuck ``j``: relative velocity ``s_j(x) = 0``; sliding ``j``: ``λ_j + N_j σ_j μ_j(|s_j|) = 0``;
   hinge ``i``: ``θ_i − θ0_i − Q_i (q₀ + Δq(x)) = 0``; solved by Newton with the laws' consistent
@@ -33,7 +34,7 @@ import numpy as np
 try:  # names injected by the loader when executed after ``_hysteresis.py`` and ``_linalg.py``
     _hyst_trial_at  # type: ignore[used-before-def]  # noqa: B018
 except NameError:  # pragma: no cover - plain import of this file (pure-Python twin)
-    from seisrack.dynamics._contact import _newmark_end, _rank1
+    from seisrack.dynamics._contact import _rank1, _step_end
     from seisrack.dynamics._events import _JIT
     from seisrack.dynamics._hysteresis import HYST_S_THETA, _hyst_trial_at
     from seisrack.dynamics._lapack import _chol, _chol_solve
@@ -115,25 +116,26 @@ def _core_weights(Q, zp, om, Kc, cmeta):
 
 
 @_JIT
-def _core_factor(kd, cd, Cq, diag, h, Ms_key, Kc, sw, D, piv):
-    """Factors, into ``Kc[1]``, of the Newton core ``K̂(h) + (4/h²)(Ms_key − I) + Kc[0] +
-    Σ_j sw_j p_j p_jᵀ``: the structure's tangent effective stiffness with its stuck pallets'
-    masses (``Ms_key``: the configuration mass ``I + Σ_stuck m_j p_j p_jᵀ``; ``sw``: sliding
-    pallets' velocity-dependent friction). Cholesky (lower triangle) when it is positive
+def _core_factor(kd, cd, Cq, diag, av, Ms_key, Kc, sw, D, piv):
+    """Factors, into ``Kc[1]``, of the Newton core ``K̂ + av²(Ms_key − I) + Kc[0] +
+    Σ_j sw_j p_j p_jᵀ`` (``K̂ = K + av C + av² I``, ``av`` the step's velocity coefficient:
+    2/h for the trapezoidal rule): the structure's tangent effective stiffness with its stuck
+    pallets' masses (``Ms_key``: the configuration mass ``I + Σ_stuck m_j p_j p_jᵀ``; ``sw``:
+    sliding pallets' velocity-dependent friction). Cholesky (lower triangle) when it is positive
     definite, else LU with pivoting (softening tangents; ``piv[0] < 0`` marks the Cholesky
     factor). Returns False if singular."""
     n = kd.shape[0]
     A = Kc[1]
-    c0 = 4.0 / (h * h)
+    c0 = av * av
     for lu in range(2):
         for r in range(n):
             for c in range(n if lu else r + 1):
                 A[r, c] = c0 * Ms_key[r, c] + Kc[0, r, c]
                 if not diag:
-                    A[r, c] += 2.0 / h * Cq[r, c]
+                    A[r, c] += av * Cq[r, c]
             A[r, r] += kd[r]
             if diag:
-                A[r, r] += 2.0 / h * cd[r]
+                A[r, r] += av * cd[r]
         for j in range(sw.shape[0]):
             if sw[j] != 0.0:
                 _rank1(A, D[j], sw[j])
@@ -156,15 +158,19 @@ def _core_solve(Kc, piv, x):
 
 @_JIT
 def _nl_trial(
-    h, kd, cd, Cq, diag, D, DH, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c, hst_t,
-    q0, qd0, qdd0, w0, wd0, wdd0, lam0, ag1, pext1, N1, stuck, sig,
+    sc, kq, kw, kd, cd, Cq, diag, D, DH, mass, mus, mud, rate, hth0, hk, hlaw, hpar, hst_c,
+    hst_t, q0, lam0, ag1, pext1, N1, stuck, sig,
     q1, qd1, qdd1, w1, wd1, wdd1, lam1, s1, hM, hz, wn, wx, Ms_key, n_cfg, Kc, piv, om, cmeta,
     stats,
 ):
-    """One Newmark step of length ``h`` with a fixed contact state and nonlinear hinges.
+    """One implicit (sub)step with a fixed contact state and nonlinear hinges: a trapezoidal
+    step, or a stage of the composite step after an event (``_kernel_stage.py``), given by
+    its relations ``sc``, ``kq``, ``kw`` (as ``_contact._step_end``; ``av = sc[1]`` is 2/h
+    on the trapezoidal rule).
 
-    ``D`` = [P; Q] ((m + n_h), n), ``DH`` = D K̂⁻¹ for this ``h``. Writes the end state, the
-    hinges' trial states ``hst_t``, moments ``hM`` and corrections ``hz``. ``wn`` (4, n) and
+    ``D`` = [P; Q] ((m + n_h), n), ``DH`` = D K̂⁻¹ for this step (``K̂ = K + av C + av² I``).
+    Writes the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections
+    ``hz``. ``wn`` (4, n) and
     ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration mass of the stuck pallets
     (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc`` (2, n, n), ``piv`` (n,),
     ``om`` (n_h,) and ``cmeta`` (3,) the Newton core's cache (zeros at the start of a run),
@@ -172,7 +178,7 @@ def _nl_trial(
     factorisations of the core (2).
 
     The Newton matrix is ``J = E + R_D D K̂⁻¹ Dᵀ Z`` (diagonal ``E``, ``R_D``, ``Z``: a stuck
-    pallet's row holds ``(h/2)/m_j`` and ``2/h``; a sliding pallet's ``1`` and its friction's
+    pallet's row holds ``β/m_j`` and ``av``; a sliding pallet's ``1`` and its friction's
     slope; a hinge's ``1``, ``1`` and column weight ``k_t − k_i``), so by Woodbury's identity
     each Newton step is one solve with the n × n core ``K̂ + Dᵀ Z E⁻¹ R_D D`` (the tangent
     effective stiffness with the stuck pallets' masses): O((m + n_h) n) a step while the core's
@@ -189,22 +195,22 @@ def _nl_trial(
     m = mass.shape[0]
     nh = hk.shape[0]
     nx = m + nh
-    c1 = 4.0 / h
-    c2 = 2.0 / h
+    c2 = sc[1]
+    hb = sc[2]
     rhs, qhat, tmp, u = wn[0], wn[1], wn[2], wn[3]
     dfree, b, x, zp, R, g, y, Ei, Rd, sw = (wx[0], wx[1], wx[2], wx[3], wx[4], wx[5], wx[6],
                                              wx[7], wx[8], wx[9])
     kt_lin, c_lin = wx[10], wx[11]  # each hinge's branch (tangent, intercept) of the last solve
-    _damp_mul(cd, Cq, diag, qd0, rhs)
+    _damp_mul(cd, Cq, diag, kq[1], rhs)
     for i in range(n):
-        rhs[i] += pext1[i] - kd[i] * q0[i] + c1 * qd0[i] + qdd0[i]
-    _modal_solve(kd, cd, Cq, diag, h, rhs, qhat)
+        rhs[i] = pext1[i] - kd[i] * q0[i] - kq[0, i] - rhs[i]
+    _modal_solve(kd, cd, Cq, diag, c2, rhs, qhat)
     for i in range(n):
-        tmp[i] = c2 * qhat[i] - qd0[i]
+        tmp[i] = c2 * qhat[i] + kq[1, i]
     # dfree: support velocities of the free prediction (then: free hinge rotations)
     _mv(D, tmp, dfree)
     for j in range(m):
-        b[j] = wd0[j] + 0.5 * h * (wdd0[j] - ag1) - dfree[j]
+        b[j] = kw[0, j] - dfree[j]
     for i in range(n):
         tmp[i] = q0[i] + qhat[i]
     _mv(D, tmp, dfree)
@@ -252,18 +258,18 @@ def _nl_trial(
         _mv(D, u, g)
         fresh = False  # the core carries velocity-dependent slopes: factor it for this iterate
         for j in range(m):
-            sj = b[j] + 0.5 * h * x[j] / mass[j] + c2 * g[j]
+            sj = b[j] + hb * x[j] / mass[j] + c2 * g[j]
             s1[j] = sj
             sw[j] = 0.0
             if stuck[j]:
                 R[j] = sj
-                Ei[j] = 0.5 * h / mass[j]
+                Ei[j] = hb / mass[j]
                 Rd[j] = c2
             else:
                 mu, dmu = _mu_slide(mus[j], mud[j], rate[j], abs(sj))
                 R[j] = x[j] + N1[j] * sig[j] * mu
                 f = N1[j] * sig[j] * dmu * (1.0 if sj >= 0.0 else -1.0)
-                Ei[j] = 1.0 + f * 0.5 * h / mass[j]
+                Ei[j] = 1.0 + f * hb / mass[j]
                 Rd[j] = f * c2
                 if f != 0.0:
                     sw[j] = Rd[j] / Ei[j]
@@ -273,10 +279,10 @@ def _nl_trial(
             Ei[m + i] = 1.0
             Rd[m + i] = 1.0
         changed = _core_weights(D[m:], zp[:nh], om, Kc, cmeta)
-        if fresh or changed or cmeta[0] != h or cmeta[2] != n_cfg:
-            ok = _core_factor(kd, cd, Cq, diag, h, Ms_key, Kc, sw[:m], D, piv)
+        if fresh or changed or cmeta[0] != c2 or cmeta[2] != n_cfg:
+            ok = _core_factor(kd, cd, Cq, diag, c2, Ms_key, Kc, sw[:m], D, piv)
             stats[2] += 1
-            cmeta[0] = h if ok and not fresh else 0.0
+            cmeta[0] = c2 if ok and not fresh else 0.0
             cmeta[2] = n_cfg
             if not ok:
                 break
@@ -306,8 +312,8 @@ def _nl_trial(
         lam1[j] = x[j]
     for i in range(nh):
         y[m + i] = hz[i]
-    _newmark_end(h, DH, y, qhat, q0, qd0, qdd0, D[:m], mass, ag1, lam1, w0, wd0, wdd0, stuck,
-                 q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, g[:m])
+    _step_end(sc, kq, kw, DH, y, qhat, q0, D[:m], mass, ag1, lam1, stuck,
+              q1, qd1, qdd1, w1, wd1, wdd1, s1, tmp, g[:m])
     return status
 
 

@@ -83,36 +83,38 @@ def _lu_solve(a, piv, x):
 
 
 @_JIT
-def _modal_solve(kd, cd, Cq, diag, h, rhs, out):
-    """Solve (K + 2/h C + 4/h^2 I) x = rhs for x (mass is identity in modal coordinates)."""
+def _modal_solve(kd, cd, Cq, diag, av, rhs, out):
+    """Solve (K + av C + av² I) x = rhs for x (mass is identity in modal coordinates): the
+    effective stiffness of a step whose velocity is ``av`` Δq + known terms (2/h for the
+    trapezoidal rule, ``_kernel_stage.py``)."""
     n = kd.shape[0]
     if diag:
         for i in range(n):
-            out[i] = rhs[i] / (kd[i] + 2.0 / h * cd[i] + 4.0 / (h * h))
+            out[i] = rhs[i] / (kd[i] + av * cd[i] + av * av)
     else:
-        Kh = (2.0 / h) * Cq.copy()
+        Kh = av * Cq.copy()
         for i in range(n):
-            Kh[i, i] += kd[i] + 4.0 / (h * h)
+            Kh[i, i] += kd[i] + av * av
         x = _solve(Kh, rhs.reshape((n, 1)))
         for i in range(n):
             out[i] = x[i, 0]
 
 
 @_JIT
-def _dh_into(kd, cd, Cq, diag, h, D, out):
-    """out = D H, with H = (K + 2/h C + 4/h^2 I)^-1 (symmetric): (H Dᵀ)ᵀ, row-major like D."""
+def _dh_into(kd, cd, Cq, diag, av, D, out):
+    """out = D H, with H = (K + av C + av² I)^-1 (symmetric): (H Dᵀ)ᵀ, row-major like D."""
     n = kd.shape[0]
     if diag:
         hi = np.empty(n)
         for i in range(n):
-            hi[i] = 1.0 / (kd[i] + 2.0 / h * cd[i] + 4.0 / (h * h))
+            hi[i] = 1.0 / (kd[i] + av * cd[i] + av * av)
         for j in range(D.shape[0]):
             for i in range(n):
                 out[j, i] = D[j, i] * hi[i]
         return
-    Kh = (2.0 / h) * Cq.copy()
+    Kh = av * Cq.copy()
     for i in range(n):
-        Kh[i, i] += kd[i] + 4.0 / (h * h)
+        Kh[i, i] += kd[i] + av * av
     out[:, :] = _solve(Kh, np.ascontiguousarray(D.T)).T
 
 

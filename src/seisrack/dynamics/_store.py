@@ -87,7 +87,7 @@ class Buffers:
         self.arrays = (
             np.empty((rows, nb)), np.empty((rows, nb)), np.empty((rows, nb)),
             np.empty((rows, m)), np.empty((rows, m)), np.empty((rows, m)),
-            np.empty((rows, m), dtype=np.bool_), np.zeros((rows, 5)), np.zeros((rows, nh)),
+            np.empty((rows, m), dtype=np.bool_), np.zeros((rows, 6)), np.zeros((rows, nh)),
         )
 
     def views(self, k: int) -> tuple[np.ndarray, ...]:
@@ -113,7 +113,7 @@ class Kept:
         self.wd = np.empty((n_keep, m))
         self.lam = np.empty((n_keep, m))
         self.stuck = np.empty((n_keep, m), dtype=np.bool_)
-        self.energy = np.zeros((n_keep, 5))
+        self.energy = np.zeros((n_keep, 6))
         self.hm = np.zeros((n_keep, nh))
         self.N = np.empty((n_keep, m))
         self.idx = np.empty(n_keep, dtype=np.int64)

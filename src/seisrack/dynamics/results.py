@@ -71,7 +71,9 @@ class TimeHistory:
     energy: cumulative arrays (n_t,) [J]: input, kinetic, strain, damping, friction, and with
     nonlinear hinges "hysteresis" (their dissipated work; "strain" is then the recoverable part);
     with the P-Δ of the current axial forces "p_delta" (the work of that force, which is not
-    the gradient of a potential: :mod:`seisrack.dynamics.axial`);
+    the gradient of a potential: :mod:`seisrack.dynamics.axial`); on the Newmark path of a line
+    "algorithmic": what the L-stable composite steps after events take out of the stiff
+    directions' residue (``dynamics/_kernel_stage.py``; zero on the trapezoidal steps);
     hinge_moment: (n_t, n_h) [N·m] and :attr:`hinge_rotation` of the nonlinear hinges.
     Here ``n_t`` counts the *kept* samples: with ``simulate(save_every=k)`` they are the steps
     listed in ``sample_index`` (every k-th and the last), at times ``t``. ``basis`` describes
@@ -170,6 +172,7 @@ class TimeHistory:
             + e["friction"]
             + e.get("hysteresis", 0.0)
             + e.get("p_delta", 0.0)
+            + e.get("algorithmic", 0.0)
         )
         scale = max(
             float(np.max(np.abs(e["input"]))),
@@ -177,7 +180,8 @@ class TimeHistory:
             float(np.max(e["strain"])),
             float(np.max(np.abs(e["damping"]))) + float(np.max(np.abs(e["friction"])))
             + float(np.max(np.abs(e.get("hysteresis", 0.0))))
-            + float(np.max(np.abs(e.get("p_delta", 0.0)))),
+            + float(np.max(np.abs(e.get("p_delta", 0.0))))
+            + float(np.max(np.abs(e.get("algorithmic", 0.0)))),
             1e-300,
         )
         return float(np.max(np.abs(lhs - rhs)) / scale)

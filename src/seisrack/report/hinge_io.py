@@ -21,6 +21,8 @@ ENERGY_LONG_NAMES = {
     "friction": "cumulative energy dissipated by pallet-beam friction",
     "hysteresis": "cumulative energy dissipated by the hysteresis of the nonlinear "
                   "connections (connectors and base plates)",
+    "algorithmic": "cumulative energy taken out by the integration's L-stable steps after "
+                   "contact events (numerical, not physical)",
 }
 
 #: what the hinge rotation is measured from (the same in the CSV notes and netCDF)
