@@ -24,7 +24,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from seisrack.dynamics import PlanarSliders, Sliders, simulate
+from seisrack.dynamics import PlanarSliders, Sliders, _run_line, simulate
 from seisrack.errors import InputError
 from seisrack.sdof.closed_form import solve_sdof
 
@@ -193,7 +193,10 @@ def _frame():
     return m, C, K
 
 
-def test_one_axis_on_a_structure_equals_the_1d_engine():
+def test_one_axis_on_a_structure_equals_the_1d_engine(monkeypatch):
+    # the planar step is the trapezoidal rule throughout; the line kernel takes composite steps
+    # after events unless told not to: the same scheme on both sides
+    monkeypatch.setattr(_run_line, "COMPOSITE_STEPS", 0)
     M, C, K = _frame()
     dt = 0.005
     t = np.arange(0, 8 + dt / 2, dt)
@@ -213,10 +216,13 @@ def test_one_axis_on_a_structure_equals_the_1d_engine():
 
 
 @pytest.mark.parametrize("mus", [0.0, 0.3])
-def test_no_dynamic_friction_equals_the_1d_engine(mus):
+def test_no_dynamic_friction_equals_the_1d_engine(mus, monkeypatch):
     """mu_d = 0 (allowed: friction >= 0) once made the plane's contact solve divide by a zero
     disc radius (a non-finite response). Along one axis it is the 1D engine's answer; with
     mu_s = 0 too, a pallet feels no force at all and keeps its absolute position."""
+    # the planar step is the trapezoidal rule throughout; the line kernel takes composite steps
+    # after events unless told not to: the same scheme on both sides
+    monkeypatch.setattr(_run_line, "COMPOSITE_STEPS", 0)
     M, C, K = _frame()
     dt = 0.005
     t = np.arange(0, 8 + dt / 2, dt)
@@ -344,7 +350,10 @@ def test_bad_run_input():
     assert exc.value.field == "C"
 
 
-def test_vertical_component_scales_the_friction_like_the_1d_engine():
+def test_vertical_component_scales_the_friction_like_the_1d_engine(monkeypatch):
+    # the planar step is the trapezoidal rule throughout; the line kernel takes composite steps
+    # after events unless told not to: the same scheme on both sides
+    monkeypatch.setattr(_run_line, "COMPOSITE_STEPS", 0)
     M, C, K = _frame()
     dt = 0.005
     t = np.arange(0, 6 + dt / 2, dt)
