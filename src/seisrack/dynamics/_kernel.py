@@ -15,7 +15,10 @@ Formulation (see ``docs/theory/stick_slip_engine.md``):
   fixed: stuck sliders satisfy zero relative velocity at the end of the step, sliding sliders carry
   ``lam = -mu_d N sign(s)`` (or their velocity-dependent law). The step, with any nonlinear
   hinges, is ``_kernel_hinge._nl_trial``: one solve with the structure's (tangent) effective
-  stiffness with the stuck sliders' masses, never a matrix of the sliders.
+  stiffness with the stuck sliders' masses, never a matrix of the sliders. The rest of an
+  event's step and the next ``comp_steps - 1`` steps are Bathe's composite, L-stable steps
+  instead (``_kernel_stage._composite``), so the jump of the contact forces leaves no
+  period-2h residue in the directions too stiff for the step.
 * Transitions are located *inside* the step: an event function per slider (``|lam| - mu_s N`` for
   stuck sliders, ``-sigma s`` for sliding ones) is driven to zero by Illinois regula falsi
   (bisection safeguard) on the sub-step length, the step is split there, and the new contact
@@ -79,7 +82,6 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
     from seisrack.dynamics._linalg import _dh_into, _mv
 
 
-
 @_JIT
 def run_kernel(
     kd, cd, Cq, diag, P, mass, mus, mud, rate, Q, hth0, hk, hlaw, hpar, hst, dt, ag, pext, N,
@@ -92,7 +94,8 @@ def run_kernel(
 
     Resumable: with ``resume`` the sliders start from ``w_state, wd_state, stuck_state,
     sig_state``, the cumulative energies from ``e_state`` (input, damping, friction, hinge
-    correction work) and the hinges from their committed states ``hst``; otherwise the sliders
+    correction work, the composite steps' algorithmic term; then the composite steps still to
+    take) and the hinges from their committed states ``hst``; otherwise the sliders
     start stuck on their supports. On return these arrays hold the final state, so a long run
     can be split into chunks (for progress reporting) without changing the result.
     ``t_offset`` [s] is added to event times.
@@ -104,7 +107,9 @@ def run_kernel(
     starts from (q = 0), hk (n_h,) elastic stiffness, hlaw, hpar,
     hst (n_h, HYST_NSTATE) law, parameters and committed state; out_hm (n_t, n_h) moments.
     out_energy columns: input, kinetic, strain (with the hinges' correction work, so that the
-    column is the structure's whole internal work), damping, friction dissipation (cumulative).
+    column is the structure's whole internal work), damping, friction dissipation (cumulative),
+    column 5 the composite steps' algorithmic term (``_kernel_stage._algorithmic``, cumulative).
+    ``comp_steps``: composite steps from each event on (0: the trapezoidal rule throughout).
     ``stats`` (int64, 4) accumulates the work: trial steps, Newton iterations, factorisations of
     the Newton core, location trials (as the planar kernel's).
     """
