@@ -241,6 +241,32 @@ def test_chunked_run_equals_one_chunk():
         np.testing.assert_allclose(many.energy[key], e, atol=1e-10 * np.max(one.energy["input"]))
 
 
+def test_a_chunk_ending_inside_a_composite_window_changes_nothing():
+    """The composite steps after an event (``_kernel_stage.py``) span the rest of the event's
+    step and the next one: a chunk that ends right after an event's step hands the next chunk
+    a composite step still to take (``e_state``), and the algorithmic energy term."""
+    model = _nonlinear_rack(0.5)
+    h = rack_hinges(model)
+    rec = _record(6.0, 2.0)
+    t = np.arange(int(round(6.0 / 0.005)) + 1) * 0.005
+    ag = np.interp(t, rec.time, rec.accel)
+    sl = Sliders(model.pallet_dofs[:, 0, 0], model.pallet_mass, 0.5, 0.4)
+    args = (model.M_sparse, model.C_sparse, model.K_sparse, sl)
+    kw = dict(dt=0.005, ground_accel=ag, influence=model.r_x, hinges=h)
+    one = simulate(*args, **kw)
+    assert len(one.events) > 5 and np.max(np.abs(one.energy["algorithmic"])) > 0.0
+    # the first chunk ends at the end of the step of the first event
+    k = int(np.floor(one.events[0].time_s / 0.005)) + 1
+    many = simulate(*args, **kw, chunk_steps=k)
+    assert [(e.slider, e.kind) for e in many.events] == [(e.slider, e.kind) for e in one.events]
+    for name, tol in (("q", 1e-8), ("sliding", 1e-8), ("friction", 1e-6),
+                      ("hinge_moment", 1e-8)):
+        np.testing.assert_allclose(getattr(many, name), getattr(one, name), rtol=0,
+                                   atol=tol * np.max(np.abs(getattr(one, name))))
+    for key, e in one.energy.items():
+        np.testing.assert_allclose(many.energy[key], e, atol=1e-10 * np.max(one.energy["input"]))
+
+
 def test_connections_start_from_their_gravity_moment():
     """A connector's moment under gravity equals k θ of the design operators' own static
     gravity solve (and, without P-Δ, the beam end moment there: equilibrium of the beam end
