@@ -170,12 +170,11 @@ def _nl_trial(
 
     ``D`` = [P; Q] ((m + n_h), n), ``DH`` = D K̂⁻¹ for this step (``K̂ = K + av C + av² I``).
     Writes the end state, the hinges' trial states ``hst_t``, moments ``hM`` and corrections
-    ``hz``. ``wn`` (4, n) and
-    ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration mass of the stuck pallets
-    (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc`` (2, n, n), ``piv`` (n,),
-    ``om`` (n_h,) and ``cmeta`` (3,) the Newton core's cache (zeros at the start of a run),
-    kept across calls. ``stats`` counts the trial (0), its Newton iterations (1) and
-    factorisations of the core (2).
+    ``hz``. ``wn`` (4, n) and ``wx`` (12, m + n_h) are scratch. ``Ms_key``: the configuration
+    mass of the stuck pallets (``_contact._cfg_update``), ``n_cfg`` its change count; ``Kc``
+    (2, n, n), ``piv`` (n,), ``om`` (n_h,) and ``cmeta`` (3,) the Newton core's cache (zeros
+    at the start of a run), kept across calls. ``stats`` counts the trial (0), its Newton
+    iterations (1) and factorisations of the core (2).
 
     The Newton matrix is ``J = E + R_D D K̂⁻¹ Dᵀ Z`` (diagonal ``E``, ``R_D``, ``Z``: a stuck
     pallet's row holds ``β/m_j`` and ``av``; a sliding pallet's ``1`` and its friction's
