@@ -92,3 +92,37 @@ def test_the_run_summary_warns_about_a_capped_basis():
                                 "static_energy_error": 0.241}})
     assert w["code"] == "basis_cap" and "141 directions" in w["message"]
     assert "24.1 %" in w["message"] and w["value"] == 141
+
+
+def test_sparse_patterns_chunked_solves_and_the_symmetric_lu_change_nothing(monkeypatch):
+    """A rack row's 2,000 friction patterns on 20,000 DOFs (issue 22) are kept sparse, solved
+    and multiplied by chunks of columns on a symmetric-ordered sparse LU of K: the basis equals
+    the dense path's (Cholesky of K, dense loads), and its static error the independent
+    projection's."""
+    import scipy.sparse as sp
+
+    from seisrack.dynamics import basis as basis_mod
+
+    n = 420  # above the dense path's limit
+    M, K = _chain(n)
+    dof = np.arange(5, n, 8)  # 52 sliders
+    loads = (M @ np.ones(n))[:, None]
+    pats = np.zeros((n, dof.size))
+    pats[dof, np.arange(dof.size)] = 1.0
+    dense_loads = np.column_stack([loads, pats])
+    opts = {"tol": 1e-2, "blocks": 2, "unit_loads": False}
+    sparse = reduced_basis(sp.csr_matrix(M), sp.csr_matrix(K), dof, np.full(dof.size, 400.0),
+                           sp.csc_matrix(dense_loads), **opts)
+    monkeypatch.setattr(basis_mod, "_CHUNK", 7)  # chunk boundaries inside the patterns
+    chunked = reduced_basis(sp.csr_matrix(M), sp.csr_matrix(K), dof, np.full(dof.size, 400.0),
+                            dense_loads, **opts)
+    monkeypatch.setattr(basis_mod, "_DENSE_MAX_DOF", 10 * n)  # dense Cholesky of K instead
+    dense = reduced_basis(M, K, dof, np.full(dof.size, 400.0), dense_loads, **opts)
+    assert sparse.size == chunked.size == dense.size and 20 < dense.size < dof.size
+    low = dense.size // 2  # the static block's Ritz values (the top ones are round-off's)
+    for other in (sparse, chunked):
+        assert np.allclose(other.w2[:low], dense.w2[:low], rtol=1e-9, atol=0.0)
+        assert abs(other.static_error - dense.static_error) <= 1e-9 * dense.static_error
+    ref = max(_energy_error_by_projection(sparse.phi, K, dense_loads[:, j])
+              for j in range(dense_loads.shape[1]))
+    assert abs(sparse.static_error - ref) <= 1e-7 * ref and ref > 1e-4

@@ -117,7 +117,7 @@ def _sections(base, below, n_up: int, n_lev: int):  # noqa: ANN001, ANN202
 def design_ops(model, phi: np.ndarray, rec, level: tuple, d) -> DesignOps:  # noqa: ANN001
     """:class:`DesignOps` of ``model`` in the basis ``phi`` (and the gravity state), from its
     :func:`~seisrack.fe.recovery.design_operators` ``d``."""
-    import scipy.sparse.linalg as sla
+    from seisrack.fe.stability import symmetric_lu
 
     n_up, n_lev = rec.n_upright, rec.n_level
     y0 = float(np.mean(model.nodes[np.asarray(model.base_nodes), 1]))
@@ -130,8 +130,8 @@ def design_ops(model, phi: np.ndarray, rec, level: tuple, d) -> DesignOps:  # no
 
     # gravity alone, K u = -g M r_y (M holds the members and the pallets' vertical masses);
     # a sparse solve of the full model, once per model
-    u0 = np.atleast_2d(sla.spsolve(model.K_sparse.tocsc(),
-                                   -model.g * (model.M_sparse @ model.r_y)))
+    u0 = np.atleast_2d(symmetric_lu(model.K_sparse).solve(
+        -model.g * (model.M_sparse @ model.r_y)))
     storeys = tuple(f"S{s + 1}" for s in range(n_lev))
     ops: dict[str, np.ndarray] = {}
     static: dict[str, np.ndarray] = {}

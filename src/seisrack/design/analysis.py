@@ -22,7 +22,6 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
-import scipy.sparse.linalg as sla
 
 from seisrack.checks.drift import sensitivity_theta, storey_gravity_loads, theta_verdict
 from seisrack.design.combination import (
@@ -45,6 +44,7 @@ from seisrack.design.operators import (
 from seisrack.design.result import DesignResult, Quantity, StoreyCheck
 from seisrack.errors import InputError
 from seisrack.fe.eigen import modal_from_matrices
+from seisrack.fe.stability import symmetric_lu
 
 #: modes computed first when not told (doubled until 90 % of the mass, up to MAX_MODES)
 DEFAULT_MODES = 30
@@ -241,8 +241,8 @@ def _modes(model: Any, M: Any, r: dict[str, np.ndarray], dirs: tuple[str, ...],
 def _gravity_state(model: Any) -> np.ndarray:
     """(n_dof,) [m, rad] static displacements under gravity alone: K u = −g M r_y (M holds the
     members and the unit loads' vertical mass)."""
-    return np.atleast_1d(sla.spsolve(model.K_sparse.tocsc(),
-                                     -model.g * (model.M_sparse @ model.r_y)))
+    return np.atleast_1d(symmetric_lu(model.K_sparse).solve(
+        -model.g * (model.M_sparse @ model.r_y)))
 
 
 def _level_forces(quantities: dict[str, Quantity], all_dirs: tuple[str, ...]) -> None:

@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from seisrack.errors import InputError, SolverError
+from seisrack.fe.stability import symmetric_lu
 
 _LOG = logging.getLogger(__name__)
 
@@ -44,6 +44,9 @@ _DENSE_MAX_DOF = 300
 DEFAULT_TARGET_SIZE = 40
 #: largest reduced basis
 DEFAULT_MAX_SIZE = 200
+#: columns of the static responses solved and multiplied at a time (bounds the temporaries:
+#: a rack row's 2,000 friction patterns on 20,000 DOFs would otherwise copy 320 MB each time)
+_CHUNK = 256
 
 
 @dataclass(frozen=True)
@@ -122,9 +125,12 @@ def reduced_basis(
     ``(K, M)`` makes the basis M-orthonormal and K-diagonal.
 
     M, K: (n, n) dense or sparse; slider_dof, slider_mass: (m,) (dof -1: on the ground);
-    loads: (n, k) load patterns [N per unit of their time series]. unit_loads: False when the
-    caller's ``loads`` already hold the sliders' force patterns (a pallet resting on several
-    nodes pushes them together), so no unit force per slider DOF is added.
+    loads: (n, k) load patterns [N per unit of their time series], dense or sparse. unit_loads:
+    False when the caller's ``loads`` already hold the sliders' force patterns (a pallet resting
+    on several nodes pushes them together), so no unit force per slider DOF is added.
+
+    Memory: the static responses (n, k) are the one dense array of the load count; the load
+    patterns stay sparse and every product with them goes by chunks of ``_CHUNK`` columns.
     """
     n = K.shape[0]
     if not (np.isfinite(tol) and 0 < tol < 1):
@@ -145,18 +151,21 @@ def reduced_basis(
             cho = scipy.linalg.cho_factor(Ks)
             solve = lambda B: scipy.linalg.cho_solve(cho, B)  # noqa: E731
         else:
-            solve = spla.splu(Ks).solve
+            solve = symmetric_lu(Ks).solve
     except (RuntimeError, np.linalg.LinAlgError) as exc:
         raise InputError(
             "K", "singular", "a stable structure (positive-definite stiffness)"
         ) from exc
-    loads = np.asarray(loads, dtype=float).reshape(n, -1)
+    loads = (sp.csc_matrix(loads, dtype=float) if sp.issparse(loads)
+             else sp.csc_matrix(np.asarray(loads, dtype=float).reshape(n, -1)))
     udofs = np.unique(dof[on]) if unit_loads else np.zeros(0, dtype=np.int64)
-    F = np.zeros((n, loads.shape[1] + udofs.size))
-    F[:, : loads.shape[1]] = loads
-    F[udofs, loads.shape[1] + np.arange(udofs.size)] = 1.0
-    block = solve(np.asfortranarray(F))
-    static = block  # K⁻¹ F: the static responses, for the error measured below
+    unit = sp.csc_matrix((np.ones(udofs.size), (udofs, np.arange(udofs.size))),
+                         shape=(n, udofs.size))
+    F = sp.hstack([loads, unit], format="csc")
+    static = np.empty(F.shape, order="F")  # K⁻¹ F: the static responses
+    for c in range(0, F.shape[1], _CHUNK):
+        static[:, c:c + _CHUNK] = solve(np.asfortranarray(F[:, c:c + _CHUNK].toarray()))
+    block = static
     V = np.zeros((n, 0))
     n_blocks, capped = 0, 0
     while n_blocks < blocks and V.shape[1] < max_size:
@@ -202,33 +211,54 @@ def static_energy_error(phi: np.ndarray, w2: np.ndarray, F: np.ndarray,
     1 − Σᵢ (φᵢᵀ f)² / ωᵢ² / (fᵀ x) (0 when x is in the basis); rigid-body directions
     (ωᵢ = 0) carry no strain energy and are left out.
     """
-    full = np.einsum("ij,ij->j", F, static)
+    if sp.issparse(F):
+        F = sp.csc_matrix(F)
+        full = np.asarray(F.multiply(static).sum(axis=0)).ravel()
+    else:
+        full = np.einsum("ij,ij->j", F, static)
     on = full > 1e-300
     if not np.any(on):
         return 0.0
     stiff = w2 > 1e-12 * max(float(np.max(w2, initial=0.0)), 1e-300)
-    proj = phi[:, stiff].T @ F[:, on]
+    proj = (F[:, on].T @ phi[:, stiff]).T
     kept = np.einsum("ij,ij->j", proj, proj / w2[stiff, None])
     return float(np.clip(1.0 - kept / full[on], 0.0, 1.0).max())
+
+
+def _gram(X, M0):  # noqa: ANN001, ANN202, N803
+    """Xᵀ M₀ X, one chunk of columns at a time."""
+    G = np.empty((X.shape[1], X.shape[1]))
+    for c in range(0, X.shape[1], _CHUNK):
+        G[:, c:c + _CHUNK] = X.T @ (M0 @ X[:, c:c + _CHUNK])
+    return G
 
 
 def _orthonormal_block(X, V, M0, tol, limit):  # noqa: ANN001, ANN202, N803
     """M₀-orthonormalise the columns of X against V and among themselves, dropping the
     directions below ``tol`` (relative); at most ``limit`` columns. Returns the block and the
-    number of directions above ``tol`` that ``limit`` dropped."""
-    # each load pattern counts alike whatever its units: scale the columns to unit M₀-norm
-    norms = np.sqrt(np.einsum("ij,ij->j", X, M0 @ X))
-    X = X[:, norms > 0] / norms[norms > 0]
-    ref = 1.0
-    for _ in range(2):  # twice is enough (Kahan–Parlett)
-        if V.shape[1]:
+    number of directions above ``tol`` that ``limit`` dropped. X is not modified; against an
+    empty V (the first block, the static responses) no copy of it is made."""
+    # each load pattern counts alike whatever its units: the columns are scaled to unit M₀-norm
+    # before the projection against V (so that ``tol`` is relative to the pattern itself)
+    if V.shape[1]:  # a later block: at most the basis size, copies are cheap
+        norms = np.sqrt(np.einsum("ij,ij->j", X, M0 @ X))
+        X = X[:, norms > 0] / norms[norms > 0]
+        for _ in range(2):  # twice is enough (Kahan–Parlett)
             X = X - V @ (V.T @ (M0 @ X))
-    G = X.T @ (M0 @ X)
+        s = np.ones(X.shape[1])
+        G = _gram(X, M0)
+    else:  # the static responses: scaled through their Gram matrix, never copied (a zero
+        # column stays zero, and its zero eigenvalue is dropped below)
+        G = _gram(X, M0)
+        d = np.clip(np.diag(G), 0.0, None)
+        s = np.zeros_like(d)
+        s[d > 0] = 1.0 / np.sqrt(d[d > 0])
+        G = s[:, None] * G * s[None, :]
     lam, Q = np.linalg.eigh(0.5 * (G + G.T))
-    keep = lam > (tol * ref) ** 2
+    keep = lam > tol ** 2
     over = max(int(np.count_nonzero(keep)) - limit, 0)
     lam, Q = lam[keep][::-1][:limit], Q[:, keep][:, ::-1][:, :limit]
-    Y = (X @ Q) / np.sqrt(lam)
+    Y = (X @ (s[:, None] * Q)) / np.sqrt(lam)
     if V.shape[1] and Y.shape[1]:  # one more pass against V for round-off
         Y = Y - V @ (V.T @ (M0 @ Y))
         Y = Y / np.sqrt(np.einsum("ij,ij->j", Y, M0 @ Y))

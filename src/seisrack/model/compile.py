@@ -156,9 +156,7 @@ def _hinges(spec: RackSpec, mesh: FrameMesh, K: sp.csr_matrix, M: sp.csr_matrix,
         th_y.append(law.yield_rotation)
     th_g = np.zeros(k.shape[0])
     if spec.hysteresis.nonlinear and k.size:
-        import scipy.sparse.linalg as spla
-
-        u_g = spla.spsolve(sp.csc_matrix(K), -spec.g * (M @ r_y))
+        u_g = symmetric_lu(K).solve(-spec.g * (M @ r_y))
         ug = np.append(u_g, 0.0)  # index -1: the ground
         th_g = ug[dofs[:, 0]] - ug[dofs[:, 1]]
         _check_gravity_elastic(spec, th_g, k, base, np.array(th_y))

@@ -21,6 +21,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from seisrack.errors import InputError, SolverError
+from seisrack.fe.stability import symmetric_lu
 
 _LOG = logging.getLogger(__name__)
 
@@ -164,7 +165,7 @@ def local_basis(M, C, K, slices: np.ndarray, loads: np.ndarray, patterns: sp.spm
     pat = sp.csc_matrix(patterns, dtype=float)
     G = loads if global_loads is None else np.column_stack([loads, global_loads])
     try:
-        lu = spla.splu(Ks.tocsc())
+        lu = symmetric_lu(Ks)
     except RuntimeError as exc:
         raise InputError("K", "singular", "a stable structure (positive-definite stiffness)") \
             from exc
@@ -189,7 +190,7 @@ def _slice_vectors(Ks, M0, P, sl, s, lo, hi, loads, pat_rows, UG, tol, blocks): 
     rowsP = Ks[P]
     KP = rowsP[:, P].tocsc()
     try:
-        lu = spla.splu(KP)
+        lu = symmetric_lu(KP)
     except RuntimeError as exc:
         raise SolverError(f"local basis: the patch of slice {s} is singular ({exc})") from exc
     pP = pat_rows[P]
@@ -297,7 +298,7 @@ def measure_error(b: LocalBasis, M, K, loads: np.ndarray, patterns: sp.spmatrix,
         pick = np.unique(np.linspace(0, npat - 1, samples - k).astype(int))
         cols.append(pat[:, pick].toarray())
     F = np.column_stack(cols)
-    lu = spla.splu(Ks)
+    lu = symmetric_lu(Ks)
     U = lu.solve(np.asfortranarray(F))
     rhs = V.T @ F
     y = np.linalg.solve(Kr, rhs) if Kr is not None else _btd_solve(b, "K", rhs)
@@ -311,7 +312,8 @@ def measure_error(b: LocalBasis, M, K, loads: np.ndarray, patterns: sp.spmatrix,
         M0 = sp.csc_matrix(M, dtype=float)
         if mass_extra is not None:
             M0 = (M0 + sp.csc_matrix(mass_extra)).tocsc()
-        w2, _ = spla.eigsh(Ks, k=n_modes, M=M0, sigma=0.0, which="LM")
+        k_inv = spla.LinearOperator(Ks.shape, matvec=lu.solve, dtype=float)
+        w2, _ = spla.eigsh(Ks, k=n_modes, M=M0, sigma=0.0, which="LM", OPinv=k_inv)
         Mr = V.T @ (M0 @ V)
         Mr = Mr.toarray() if sp.issparse(Mr) else Mr
         Kd = Kr if Kr is not None else dense(b, "K")
