@@ -71,13 +71,23 @@ ANNOUNCE_S = 30.0
 #: most 40 Ritz vectors plus the pallets' (README, "Cost of a new contact configuration"); the
 #: 3D planar engine used 86-144 on the 5 x 10 warehouse rack (docs/theory/planar_friction.md).
 BASIS_ESTIMATE = 150
+#: The 3D planar engine's Ritz basis grows with the pallets (40 vectors with 4, 86 with 150) up
+#: to its cap (``dynamics.basis.DEFAULT_MAX_SIZE``; the 40 x 8 row with 960 pallets reaches it)
+BASIS_ESTIMATE_3D_MAX = 200
 #: [s] cost per analysis step: a fixed part, per pallet, per basis vector. Measured under El
 #: Centro (7,988 steps, numba, 2 shared cores): paper rack 6.6 µs/step, 3-level rack 19 µs,
 #: paper rack nonlinear 17 µs, warehouse rack (400 pallets, mu 0.1) 1,071 µs; 3D paper rack
 #: 50 µs, 3D warehouse rack (150 pallets) 1,440 µs (planar contact costs more per pallet).
+#: A 3D pallet costs more the larger the basis: its events factorise the (r, r) Newton matrix.
+#: Measured on 20 s of the EC8 pair (5 ms): the 150-pallet example (r = 86) 1.9 ms a step, the
+#: 40 x 8 row (960 pallets, r = 200) 25.5 ms a step, i.e. 13-27 µs a pallet, about 1.45e-7 r.
 STEP_S = 5.0e-6
-STEP_S_PER_PALLET = (2.5e-6, 9.0e-6)  # (2D, 3D)
+STEP_S_PER_PALLET = 2.5e-6  # 2D
+STEP_S_PER_PALLET_BASIS_3D = 1.45e-7
 STEP_S_PER_BASIS = 2.0e-8
+#: [s] the Ritz basis's preparation per n_dof x (load patterns)²: its Gram matrix and the
+#: patterns' static responses (40 x 8 row, 20,836 DOFs, 1,923 patterns: 14 s)
+PREP_S_PER_NK2 = 2.0e-10
 
 # ---------------------------------------------------------------------------- modal analysis
 #: Most modes a command computes: far more than any participation criterion needs (EN 1998-1
@@ -245,7 +255,7 @@ class RunEstimate:
 
 def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: int,
                  n_levels: int, save_every: int | None, vertical: bool = False,
-                 three_d: bool = False) -> RunEstimate:
+                 three_d: bool = False, n_design: int = 0) -> RunEstimate:
     """Estimate a time history of ``n_record`` record samples (``k`` analysis steps each),
     ``n_pad`` samples of free vibration, on a rack of ``n_dof`` DOFs and ``n_pallets``.
 
@@ -253,20 +263,45 @@ def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: in
     engine's load series: about 4 arrays of the analysis length, 6 with a vertical record),
     the full-rate level accelerations of the filtered peak (at most
     ``analysis.peaks.FULL_RATE_ACCEL_MAX`` values), and per kept sample the basis coordinates
-    (3 arrays), the pallets' states (6) and the level results (10).
+    (3 arrays), the pallets' states (6) and the level results (10). ``n_design``: the design
+    histories per kept sample that the run's writer adds (:func:`design_items`; 0 when nothing
+    is written): they, and the written dataset's copy of every history with them, count
+    too. Above 50 DOFs the Ritz basis's preparation (the static responses of the load
+    patterns, (n_dof, p), and their Gram matrix, p = one pattern per pallet and direction) is
+    freed before the run: the larger of the two counts.
     """
     n_steps = max(0, (n_record - 1 + n_pad) * k)
     n_t = n_steps + 1
     nb = n_dof if n_dof <= 50 else min(n_dof, BASIS_ESTIMATE)
+    if three_d and n_dof > 50:  # the planar Ritz basis: 40 (4 pallets), 86 (150), capped 200
+        nb = int(min(n_dof, BASIS_ESTIMATE_3D_MAX, 40 + 0.3 * n_pallets))
     n_keep = 2 if save_every is None else n_steps // max(1, save_every) + 2
     series = 8.0 * ((n_record + n_pad) * 2 + n_t * (6 if vertical else 4)
                     + min(n_t * n_levels, 10_000_000))
-    memory = series + 8.0 * n_keep * (3 * nb + 6 * n_pallets * (2 if three_d else 1)
-                                      + 10 * n_levels + 10)
-    per_step = (STEP_S + STEP_S_PER_PALLET[1 if three_d else 0] * n_pallets
-                + STEP_S_PER_BASIS * nb)
+    per_sample = 3 * nb + 6 * n_pallets * (2 if three_d else 1) + 10 * n_levels + 10
+    if n_design:  # written: the design histories, then the dataset (every history once more)
+        per_sample = per_sample + 2 * (per_sample + n_design)
+    n_pat = (2 if three_d else 1) * n_pallets + 3 if n_dof > 50 else 0
+    prep = 8.0 * (n_dof * n_pat + 3 * n_pat * n_pat)
+    memory = max(series + 8.0 * n_keep * per_sample, prep)
+    per_pallet = (STEP_S_PER_PALLET_BASIS_3D * max(nb, 62) if three_d
+                  else STEP_S_PER_PALLET)
+    per_step = STEP_S + per_pallet * n_pallets + STEP_S_PER_BASIS * nb
+    seconds = n_steps * per_step + PREP_S_PER_NK2 * n_dof * n_pat * n_pat
     return RunEstimate(n_steps=n_steps, n_keep=n_keep, memory=memory,
-                       seconds=n_steps * per_step, series_memory=series)
+                       seconds=seconds, series_memory=series)
+
+
+def design_items(*, n_bays: int, n_levels: int, n_sides: int, three_d: bool) -> int:
+    """Design histories a run's ``timehistory.nc`` holds per kept sample: beam-end moments and
+    shears and connector moments and rotations (two ends of each beam, each bay, level and
+    frame), upright axial force and moments (two in 3D) at every level's section and the base,
+    upright moments per level and direction, and the drifts."""
+    ends = 2 * n_bays * n_levels * n_sides
+    uprights = (n_bays + 1) * n_sides
+    n_dir = 2 if three_d else 1
+    return (4 * ends + (3 if three_d else 2) * uprights * (n_levels + 1)
+            + uprights * (n_levels + 1) * n_dir + n_levels * n_dir)
 
 
 def check_run(est: RunEstimate, *, n_record: int, n_pad: int, save_every: int | None,

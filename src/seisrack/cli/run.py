@@ -234,19 +234,25 @@ def _progress_bar(n_steps: int) -> Any:
 def check_run_size(args: argparse.Namespace, model: Any, motion: Any) -> None:
     """Estimate the run's memory and time from the ground motion's length and the rack, and
     refuse it up front when out of reach (:mod:`seisrack.limits`); announce a long one."""
+    import numpy as np
+
     from seisrack.analysis import analysis_grid
     from seisrack.errors import InputError
-    from seisrack.limits import ANNOUNCE_S, check_run, estimate_run
+    from seisrack.limits import ANNOUNCE_S, check_run, design_items, estimate_run
 
     try:
         k = analysis_grid(motion, args.dt)
     except InputError:
         return  # the run reports the bad --dt itself
     n_pad = int(round(args.free_vibration / motion.dt))
+    n_lev = max(1, len(model.level_y))
+    n_design = 0 if getattr(args, "out", None) is None else design_items(
+        n_bays=max(1, len(model.upright_x) - 1), n_levels=n_lev, three_d=model.ndm == 3,
+        n_sides=int(np.max(model.element_side, initial=0)) + 1)
     est = estimate_run(n_record=motion.n, k=k, n_pad=n_pad, n_dof=model.n_dof,
-                       n_pallets=model.n_pallets, n_levels=max(1, len(model.level_y)),
+                       n_pallets=model.n_pallets, n_levels=n_lev,
                        save_every=args.save_every, vertical=motion.v is not None,
-                       three_d=model.ndm == 3)
+                       three_d=model.ndm == 3, n_design=n_design)
     check_run(est, n_record=motion.n, n_pad=n_pad, save_every=args.save_every)
     if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:
         print(f"seisrack: estimated: {est.describe()} (one core)", file=sys.stderr)
