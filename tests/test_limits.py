@@ -134,6 +134,23 @@ def test_over_budget_suggests_save_every(monkeypatch, capsys):
     assert json.loads(capsys.readouterr().out)["status"] == "ok"
 
 
+def test_a_ritz_basis_too_large_to_prepare_is_refused_by_name():
+    """A rack row whose Ritz basis preparation (the static responses of one load pattern per
+    pallet and direction, n_dof x 2 m) exceeds the budget is refused naming the rack, not
+    --save-every (no choice of kept samples makes it fit); the local engine, which builds no
+    such basis, is not."""
+    kw = {"n_record": 2001, "k": 2, "n_pad": 0, "n_dof": 60_000, "n_pallets": 4_000,
+          "n_levels": 10, "save_every": None, "three_d": True}
+    est = limits.estimate_run(**kw)
+    assert est.prep_memory == 8.0 * (60_000 * 8_003 + 3 * 8_003 ** 2)  # 5.4 GB
+    with pytest.raises(InputError) as exc:
+        limits.check_run(est, n_record=2001, n_pad=0, save_every=None, budget=4 * 2**30)
+    assert exc.value.field == "rack" and "--engine local" in str(exc.value)
+    local = limits.estimate_run(**kw, ritz=False)
+    assert local.prep_memory == 0.0
+    limits.check_run(local, n_record=2001, n_pad=0, save_every=None, budget=4 * 2**30)
+
+
 def test_run_memory_estimate_against_tracemalloc():
     """The estimate bounds the measured peak of the Python/numpy allocations of a run, within
     a factor of 4 either way (it is meant to tell a typo from a large job)."""

@@ -247,6 +247,7 @@ class RunEstimate:
     memory: float  # [B]
     seconds: float  # [s], one core
     series_memory: float  # [B] the part that does not depend on --save-every
+    prep_memory: float = 0.0  # [B] the Ritz basis's preparation, freed before the run
 
     def describe(self) -> str:
         return (f"{self.n_steps:,} analysis steps, about {fmt_bytes(self.memory)} and "
@@ -255,7 +256,7 @@ class RunEstimate:
 
 def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: int,
                  n_levels: int, save_every: int | None, vertical: bool = False,
-                 three_d: bool = False, n_design: int = 0) -> RunEstimate:
+                 three_d: bool = False, n_design: int = 0, ritz: bool = True) -> RunEstimate:
     """Estimate a time history of ``n_record`` record samples (``k`` analysis steps each),
     ``n_pad`` samples of free vibration, on a rack of ``n_dof`` DOFs and ``n_pallets``.
 
@@ -268,7 +269,8 @@ def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: in
     is written): they, and the written dataset's copy of every history with them, count
     too. Above 50 DOFs the Ritz basis's preparation (the static responses of the load
     patterns, (n_dof, p), and their Gram matrix, p = one pattern per pallet and direction) is
-    freed before the run: the larger of the two counts.
+    freed before the run: the larger of the two counts (``ritz``: False for an engine that
+    builds no such basis, the local one).
     """
     n_steps = max(0, (n_record - 1 + n_pad) * k)
     n_t = n_steps + 1
@@ -281,15 +283,15 @@ def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: in
     per_sample = 3 * nb + 6 * n_pallets * (2 if three_d else 1) + 10 * n_levels + 10
     if n_design:  # written: the design histories, then the dataset (every history once more)
         per_sample = per_sample + 2 * (per_sample + n_design)
-    n_pat = (2 if three_d else 1) * n_pallets + 3 if n_dof > 50 else 0
+    n_pat = (2 if three_d else 1) * n_pallets + 3 if ritz and n_dof > 50 else 0
     prep = 8.0 * (n_dof * n_pat + 3 * n_pat * n_pat)
-    memory = max(series + 8.0 * n_keep * per_sample, prep)
+    memory = max(series + 8.0 * n_keep * per_sample, prep)  # prep is freed before the run
     per_pallet = (STEP_S_PER_PALLET_BASIS_3D * max(nb, 62) if three_d
                   else STEP_S_PER_PALLET)
     per_step = STEP_S + per_pallet * n_pallets + STEP_S_PER_BASIS * nb
     seconds = n_steps * per_step + PREP_S_PER_NK2 * n_dof * n_pat * n_pat
     return RunEstimate(n_steps=n_steps, n_keep=n_keep, memory=memory,
-                       seconds=seconds, series_memory=series)
+                       seconds=seconds, series_memory=series, prep_memory=prep)
 
 
 def design_items(*, n_bays: int, n_levels: int, n_sides: int, three_d: bool) -> int:
@@ -321,8 +323,14 @@ def check_run(est: RunEstimate, *, n_record: int, n_pad: int, save_every: int | 
                          f"free memory, at most {fmt_bytes(MEMORY_CEILING)})",
                          hint=f"This run would be {est.describe()}; use a larger --dt or a "
                               "shorter record or free vibration")
+    if est.prep_memory > budget:
+        raise InputError("rack", f"{fmt_bytes(est.prep_memory)} for the static responses of its "
+                         "Ritz basis's load patterns (one per pallet and direction)",
+                         f"a rack whose basis preparation fits in {fmt_bytes(budget)}",
+                         hint="Use --engine local (a basis built slice by slice), or split the "
+                              "rack into shorter rows")
     if est.memory > budget:
-        per_sample = (est.memory - est.series_memory) / max(est.n_keep, 1)
+        per_sample = (est.memory - est.series_memory) / max(est.n_keep, 1)  # prep fits: histories
         fits = max(1, int((budget - est.series_memory) / max(per_sample, 1.0)))
         every = max(2, math.ceil(est.n_steps / fits))
         raise InputError("--save-every", save_every, f"a value that keeps the histories "
