@@ -41,7 +41,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _propose3,
         _substep_end,
     )
-    from seisrack.dynamics._planar_axial import _axial_force, _trial_ax
+    from seisrack.dynamics._planar_axial import _axial_force
     from seisrack.dynamics._planar_events import (
         _classify,
         _decide,
@@ -55,6 +55,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _track_direction,
     )
     from seisrack.dynamics._planar_hinges import _hinge_commit_at, _hinge_committed, _minus_qtz
+    from seisrack.dynamics._planar_stage import GAMMA_PL, _algorithmic_pl, _stage_work, _step
     from seisrack.dynamics._planar_step import _sample_row
 
 #: status of a Newton iteration of the planar step that did not converge
@@ -89,7 +90,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                out_q, out_qd, out_qdd, out_u, out_v, out_lam, out_stuck,
                ev_time, ev_pallet, ev_kind, stats,
                Q, hth0, hk, hlaw, hpar, hst, HW, e_state, out_hm, out_energy,
-               AA, AG, Ao, As, Ac):
+               AA, AG, Ao, As, Ac, comp_steps):
     """Integrate ``agx.shape[0] - 1`` steps. Returns (status, n_events, n_substeps, the last
     output row written).
 
@@ -114,10 +115,15 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     committed states (read and written back, as the pallets' state), ``HW`` (4, n_h) scratch
     that goes with ``A``; ``out_hm`` (n_t, n_h) their moments. Energy (cumulative from the
     start of the run, resumed from ``e_state``: input, damping, friction, the hinges'
-    correction work ∫ z dθ, the work of the P-Δ of the axial forces' change ∫ f · dq):
-    ``out_energy`` (n_t, 6) columns input, kinetic, strain (with both works), damping,
-    friction, the P-Δ work; ``out_energy`` with no columns (n_t, 0): the energy terms are not
-    computed (nobody reads them: a study's runs).
+    correction work ∫ z dθ, the work of the P-Δ of the axial forces' change ∫ f · dq, what the
+    composite steps take out, then the composite steps still to take):
+    ``out_energy`` (n_t, 7) columns input, kinetic, strain (with both works), damping,
+    friction, the P-Δ work, the composite steps' algorithmic term; ``out_energy`` with no
+    columns (n_t, 0): the energy terms are not computed (nobody reads them: a study's runs).
+
+    ``comp_steps``: the first ``comp_steps`` steps of a run, and after an event the rest of its
+    step and the next ``comp_steps - 1``, are Bathe's composite steps (``_planar_stage.py``);
+    0: the trapezoidal rule throughout; more than the run's steps: composite throughout.
 
     The P-Δ of the current axial forces (``_planar_axial.py``): ``AA`` (n_m, r), ``AG``
     (n_g, r), ``Ao``, ``As``, ``Ac`` (n_g,) the operators of :mod:`seisrack.dynamics.axial` in
@@ -134,12 +140,26 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     dqb = np.empty(r)  # trial starts from their quadratic interpolation through dq(0) = 0
     dqg = np.empty(r)
     qdd_full = np.empty(r)
-    T0 = T_state.copy()
-    S0 = S_state.copy()
-    T1 = np.empty_like(T0)
-    S1 = np.empty_like(S0)
-    Tb = np.empty_like(T0)
-    Sb = np.empty_like(S0)
+    # the state: T rows q, qd, qdd; S rows w, wd, wdd, lam, s, vn; rows 3-5 and 6-11 of the
+    # trial and bracket states: a composite step's mid state
+    T0 = np.zeros((6, r))
+    S0 = np.zeros((12, 2 * m))
+    T0[:3] = T_state
+    S0[:6] = S_state
+    T1 = np.zeros_like(T0)
+    S1 = np.zeros_like(S0)
+    Tb = np.zeros_like(T0)
+    Sb = np.zeros_like(S0)
+    kq = np.empty((2, r))  # a step's relations (_planar_stage.py)
+    kw = np.empty((2, 2 * m))
+    ag_m = np.empty(2)  # the excitation at a composite step's mid state
+    pe_m = np.empty(r)
+    N_m = np.empty(m)
+    dqp = np.empty(r)
+    hst_m = hst.copy()  # the hinges at a composite step's mid state
+    hzm = np.empty(hk.shape[0])
+    ew = np.zeros(3)  # the work of a sub-step: input, damping, friction
+    agb = np.empty(2)
     e_lo = np.empty(m)
     e_hi = np.empty(m)
     e_try = np.empty(m)
@@ -174,6 +194,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     ena = np.empty(2)
     E_in, E_damp, E_fric, E_z = e_state[0], e_state[1], e_state[2], e_state[3]
     E_ax = e_state[4]
+    E_alg = e_state[5]
+    n_comp = int(e_state[6])
     track = out_energy.shape[1] > 0
     AXW = np.empty((4, r))  # scratch of _trial_ax
     dn = np.empty(AA.shape[0])
@@ -182,7 +204,8 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     fb = np.empty(r)
     axial = AG.shape[0] > 0
     if not resume:
-        E_in, E_damp, E_fric, E_z, E_ax = 0.0, 0.0, 0.0, 0.0, 0.0
+        E_in, E_damp, E_fric, E_z, E_ax, E_alg = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        n_comp = comp_steps
         # pallets start stuck, moving with their supports
         stuck[:] = False
         S[:, :] = 0.0
@@ -217,7 +240,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
     if axial:
         _axial_force(AA, AG, Ao, As, Ac, T0[0], dn, gw, fa)
     if track:
-        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, out_energy)
+        _energy_row(0, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, E_alg, out_energy)
     k_done = 0
     n_tr = np.zeros(m, dtype=np.int64)
     frozen = np.zeros(m, dtype=np.bool_)
@@ -229,16 +252,19 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
             frozen[p] = False
         while True:
             hrem = (1.0 - tau) * dt
+            comp = n_comp > 0
+            if comp:
+                _sample_mid(agx, agz, pext, N, k, tau + GAMMA_PL * (1.0 - tau), ag_m, pe_m, N_m)
             for p in range(m):
                 N0[p] = _interp(N[k, p], N[k + 1, p], tau)
             ag[0] = agx[k + 1]
             ag[1] = agz[k + 1]
             for i in range(r):
                 dqg[i] = hrem * T0[1, i] + 0.5 * hrem * hrem * T0[2, i]
-            ok = _trial_ax(hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn,
-                           ag, pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt, W, A, G, PF,
-                           stats, dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_t, hz, hMt,
-                           hzt, HW, AA, AG, Ao, As, Ac, AXW, dn, gw)
+            ok = _step(hrem, comp, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck,
+                       dirn, ag_m, pe_m, N_m, ag, pext[k + 1], N[k + 1], T1, S1, e_hi, tolF, dt,
+                       W, A, G, PF, stats, dqg, True, fac, Q, hth0, hk, hlaw, hpar, hst, hst_m,
+                       hst_t, hz, hzm, hMt, hzt, HW, AA, AG, Ao, As, Ac, AXW, dn, gw, dqp)
             _mask_frozen(frozen, e_hi)
             if ok != 0:
                 status = STATUS_PLANAR_NEWTON + ok - 1
@@ -288,10 +314,14 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                         for i in range(r):
                             dqg[i] = hs * T0[1, i] + 0.25 * hs * hs * (
                                 2.0 * T0[2, i] + th * (qdd_full[i] - T0[2, i]))
-                    ok = _trial_ax(th * hrem, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0,
-                                   stuck, dirn, ag, pe, Ne, T1, S1, e_try, tolT, dt, W, A, G,
-                                   PF, stats, dqg, warm, fac, Q, hth0, hk, hlaw, hpar, hst,
-                                   hst_t, hz, hMt, hzt, HW, AA, AG, Ao, As, Ac, AXW, dn, gw)
+                    if comp:
+                        _sample_mid(agx, agz, pext, N, k, tau + GAMMA_PL * th * (1.0 - tau),
+                                    ag_m, pe_m, N_m)
+                    ok = _step(th * hrem, comp, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0,
+                               S0, N0, stuck, dirn, ag_m, pe_m, N_m, ag, pe, Ne, T1, S1, e_try,
+                               tolT, dt, W, A, G, PF, stats, dqg, warm, fac, Q, hth0, hk, hlaw,
+                               hpar, hst, hst_m, hst_t, hz, hzm, hMt, hzt, HW, AA, AG, Ao, As,
+                               Ac, AXW, dn, gw, dqp)
                     dqb[:] = dqa
                     thb = tha
                     tha = th
@@ -307,35 +337,47 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                     break
                 th_hi = _bracket_end(br, T1, S1, Tb, Sb)
             # the work over the accepted sub-step [tau, tau_end] (Newmark's energy identity:
-            # forces averaged over its two ends, which is exact for the trapezoidal rule)
+            # forces averaged over the two ends of each stage, which is exact for the
+            # trapezoidal rule; a backward-difference stage's excess is the algorithmic term)
+            tau_e = _substep_end(tau, th_hi, any_ev)
             if track:
-                tau_e = _substep_end(tau, th_hi, any_ev)
                 _sample_row(pext, k, tau, pea)
                 _sample_row(pext, k, tau_e, peb)
-                ena[0] = 0.5 * (_interp(agx[k], agx[k + 1], tau)
-                                + _interp(agx[k], agx[k + 1], tau_e))
-                ena[1] = 0.5 * (_interp(agz[k], agz[k + 1], tau)
-                                + _interp(agz[k], agz[k + 1], tau_e))
-                for i in range(r):
-                    dqe[i] = T1[0, i] - T0[0, i]
-                    E_in += dqe[i] * 0.5 * (pea[i] + peb[i])
-                    E_damp += dqe[i] * cd[i] * 0.5 * (T0[1, i] + T1[1, i])
-                if Co.shape[0] > 0:  # the off-diagonal damping: dqᵀ Co (qd0 + qd1) / 2
-                    for i in range(r):
-                        pea[i] = 0.5 * (T0[1, i] + T1[1, i])
-                    E_damp += np.dot(dqe, np.dot(Co, pea))
+                ena[0] = _interp(agx[k], agx[k + 1], tau)
+                ena[1] = _interp(agz[k], agz[k + 1], tau)
+                agb[0] = _interp(agx[k], agx[k + 1], tau_e)
+                agb[1] = _interp(agz[k], agz[k + 1], tau_e)
+                ew[:] = 0.0
+                if comp:
+                    _sample_mid(agx, agz, pext, N, k, tau + GAMMA_PL * (tau_e - tau), ag_m,
+                                pe_m, N_m)
+                    _stage_work(T0, S0, T1[3:6], S1[6:12], pea, pe_m, ena, ag_m, cd, Co, P,
+                                mass, dqe, ew)
+                    _stage_work(T1[3:6], S1[6:12], T1, S1, pe_m, peb, ag_m, agb, cd, Co, P,
+                                mass, dqe, ew)
+                    E_alg += _algorithmic_pl(T1[3:6], S1[6:12], T1, S1, mass)
+                else:
+                    _stage_work(T0, S0, T1, S1, pea, peb, ena, agb, cd, Co, P, mass, dqe, ew)
+                E_in += ew[0]
+                E_damp += ew[1]
+                E_fric += ew[2]
                 if axial:  # the P-Δ force's work, by the trapezoid as every other force's
+                    if comp:
+                        _axial_force(AA, AG, Ao, As, Ac, T1[3], dn, gw, fb)
+                        for i in range(r):
+                            E_ax += 0.5 * (fa[i] + fb[i]) * (T1[3, i] - T0[0, i])
+                        fa[:] = fb
+                        for i in range(r):
+                            dqe[i] = T1[0, i] - T1[3, i]
+                    else:
+                        for i in range(r):
+                            dqe[i] = T1[0, i] - T0[0, i]
                     _axial_force(AA, AG, Ao, As, Ac, T1[0], dn, gw, fb)
                     for i in range(r):
                         E_ax += 0.5 * (fa[i] + fb[i]) * dqe[i]
                     fa[:] = fb
-                vrel = np.dot(P, dqe)
-                for p in range(m):
-                    for c in range(2):
-                        j = 2 * p + c
-                        dw = S1[0, j] - S0[0, j]
-                        E_in -= mass[p] * dw * ena[c]
-                        E_fric -= 0.5 * (S0[3, j] + S1[3, j]) * (dw - vrel[j])
+            if nh > 0 and comp:  # through the mid state: the laws are path-dependent
+                E_z += _hinge_commit_at(Q, hth0, hk, hlaw, hpar, hst, hst_t, T1[3], hM, hz)
             T0[:] = T1
             S0[:] = S1
             if nh > 0:
@@ -375,8 +417,11 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                             frozen[p] = True
                 n_ev = _record(old_stuck, stuck, turned, t_offset + (k + tau) * dt, n_ev,
                                max_events, ev_time, ev_pallet, ev_kind)
+                n_comp = comp_steps
                 _fill_relative(P, T0, S0)
             if tau >= 1.0:
+                if n_comp > 0 and not any_ev:
+                    n_comp -= 1
                 break
             n_here += 1
             n_sub += 1
@@ -389,7 +434,7 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
                 out_stuck)
         out_hm[k + 1, :] = hM
         if track:
-            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax,
+            _energy_row(k + 1, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, E_alg,
                         out_energy)
         k_done = k + 1
         if not _finite_state(T0, S0):
@@ -397,8 +442,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
             break
     if n_ev > max_events and status == STATUS_OK:
         status = STATUS_EVENT_OVERFLOW
-    T_state[:] = T0
-    S_state[:] = S0
+    T_state[:] = T0[:3]
+    S_state[:] = S0[:6]
+    e_state[5] = E_alg
+    e_state[6] = n_comp
     e_state[0] = E_in
     e_state[1] = E_damp
     e_state[2] = E_fric
@@ -408,10 +455,10 @@ def run_planar(kd, cd, Co, P, mass, mus, mud, dt, agx, agz, pext, N, resume, T_s
 
 
 @_JIT
-def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, out_energy):
+def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, E_alg, out_energy):
     """Row ``k`` of the energy output: input, kinetic (structure and pallets, relative to the
     ground), strain (½ qᵀ kd q plus the hinges' correction work and the P-Δ force's work),
-    damping, friction, the P-Δ force's work alone."""
+    damping, friction, the P-Δ force's work alone, the composite steps' algorithmic term."""
     kin = 0.5 * np.dot(T0[1], T0[1])
     for p in range(mass.shape[0]):
         kin += 0.5 * mass[p] * (S0[1, 2 * p] ** 2 + S0[1, 2 * p + 1] ** 2)
@@ -424,3 +471,15 @@ def _energy_row(k, T0, S0, kd, mass, E_in, E_damp, E_fric, E_z, E_ax, out_energy
     out_energy[k, 3] = E_damp
     out_energy[k, 4] = E_fric
     out_energy[k, 5] = E_ax
+    out_energy[k, 6] = E_alg
+
+
+@_JIT
+def _sample_mid(agx, agz, pext, N, k, frac, ag_m, pe_m, N_m):
+    """The excitation at the fraction ``frac`` of step ``k``: ground accelerations, modal
+    loads, normal forces."""
+    ag_m[0] = _interp(agx[k], agx[k + 1], frac)
+    ag_m[1] = _interp(agz[k], agz[k + 1], frac)
+    _sample_row(pext, k, frac, pe_m)
+    for p in range(N_m.shape[0]):
+        N_m[p] = _interp(N[k, p], N[k + 1, p], frac)

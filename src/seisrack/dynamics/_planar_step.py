@@ -124,10 +124,13 @@ def _huber(yx, yz, cc, mp, h):
 
 
 @_JIT
-def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1, N1,
-           T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
+def _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
+           N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
            Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW):
-    """One Newmark step of length ``h`` with a fixed contact state, from (T0, S0) to (T1, S1).
+    """One step with a fixed contact state, from (T0, S0) to (T1, S1): the trapezoidal rule
+    over ``h`` or a stage of the composite step (``_planar_stage.py``), given by its relations
+    (``v = 2/h``, ``a = v²``): ``q̇₁ = v Δq + kq[1]``, ``q̈₁ = a Δq + kq[0]``, a pallet's
+    ``ẇ₁ = (h/2) λ₁/m + kw[0]`` and ``w₁ = kw[1] + (h/2) ẇ₁``; equilibrium at the end.
 
     T rows: q, qd, qdd (r); S rows: w, wd, wdd, lam, s (relative velocity), vn (support
     velocity) (2m). Writes the event values ``e`` (positive when the state is violated) and
@@ -159,10 +162,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     m = mass.shape[0]
     m2 = 2 * m
     c0 = 4.0 / (h * h)
-    c1 = 4.0 / h
     c2 = 2.0 / h
-    q0, qd0, qdd0 = T0[0], T0[1], T0[2]
-    w0, wd0, wdd0 = S0[0], S0[1], S0[2]
+    q0 = T0[0]
     rhs, dq, res, stp, rlin, dg = W[0, :r], W[1, :r], W[2, :r], W[3, :r], W[4, :r], W[5, :r]
     zf, lam, pd, ps = W[6, :m2], W[7, :m2], W[8, :m2], W[9, :m2]
     stats[0] += 1
@@ -172,23 +173,22 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     for i in range(nh):
         thb[i] = hth0[i] + np.dot(Q[i], q0)
     hasco = Co.shape[0] > 0
-    # Co dq, updated with the steps of dq as sd (Co qd0 first), and Co times a Newton step:
+    # Co dq, updated with the steps of dq as sd (Co kq[1] first), and Co times a Newton step:
     # exact zeros without Co (then never touched again in this call)
     od, so = W[11, :r], W[12, :r]
-    _damp_off(Co, qd0, od)
+    _damp_off(Co, kq[1], od)
     if not hasco:
         so[:] = 0.0
     for i in range(r):
         dg[i] = c0 + c2 * cd[i] + kd[i]
-        rhs[i] = (pext1[i] + c1 * qd0[i] + qdd0[i] + cd[i] * qd0[i] + od[i]
-                  - kd[i] * q0[i])
+        rhs[i] = pext1[i] - kq[0, i] - cd[i] * kq[1, i] - od[i] - kd[i] * q0[i]
     # a stuck pallet is a mass on its support: lam = m c0 P dq + beta with
-    # beta = m (-2 c2 P qd0 - P qdd0 + ag) (its velocity and acceleration are its support's),
-    # so that Σ_stuck P_pᵀ beta_p = -S (2 c2 qd0 + qdd0) + ag_x g_x + ag_z g_z
+    # beta = m (P kq[0] + ag) (its velocity and acceleration are its support's),
+    # so that Σ_stuck P_pᵀ beta_p = S kq[0] + ag_x g_x + ag_z g_z
     Ss = S[:r]
     x0 = np.empty(r)
     for i in range(r):
-        x0[i] = 2.0 * c2 * qd0[i] + qdd0[i]
+        x0[i] = -kq[0, i]
     sx = np.dot(Ss, x0)
     for i in range(r):
         rhs[i] += sx[i] - ag1[0] * S[r, i] - ag1[1] * S[r + 1, i]
@@ -202,13 +202,13 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
             n_slide += 1
     nf = 2 * n_slide
     PFs = PF[:nf]
-    pq = np.dot(PFs, qd0)
+    pq = np.dot(PFs, kq[1])
     for a in range(n_slide):
         p = sl[a]
         for c in range(2):
             j = 2 * p + c
             jf = 2 * a + c
-            zf[jf] = wd0[j] + 0.5 * h * (wdd0[j] - ag1[c]) + pq[jf]
+            zf[jf] = kw[0, j] - pq[jf]
             lam[jf] = -mud[p] * N1[p] * dirn[j]  # first iterate: the current direction
     zf, lam, pd, ps = zf[:nf], lam[:nf], pd[:nf], ps[:nf]
     refac = True
@@ -384,8 +384,8 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
     w1, wd1, wdd1, lam1, s1, vn1 = S1[0], S1[1], S1[2], S1[3], S1[4], S1[5]
     for i in range(r):
         q1[i] = q0[i] + dq[i]
-        qd1[i] = c2 * dq[i] - qd0[i]
-        qdd1[i] = c0 * dq[i] - c1 * qd0[i] - qdd0[i]
+        qd1[i] = c2 * dq[i] + kq[1, i]
+        qdd1[i] = c0 * dq[i] + kq[0, i]
     vn1[:] = np.dot(P, qd1)
     a = 0
     for p in range(m):
@@ -393,13 +393,13 @@ def _trial(h, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pe
             j = 2 * p + c
             if stuck[p]:
                 wd1[j] = vn1[j]
-                wdd1[j] = c2 * (wd1[j] - wd0[j]) - wdd0[j]
+                wdd1[j] = c2 * (wd1[j] - kw[0, j]) - ag1[c]
                 lam1[j] = mass[p] * (wdd1[j] + ag1[c])
             else:
                 lam1[j] = lam[2 * a + c]
                 wdd1[j] = -ag1[c] + lam1[j] / mass[p]
-                wd1[j] = wd0[j] + 0.5 * h * (wdd0[j] + wdd1[j])
-            w1[j] = w0[j] + h * wd0[j] + 0.25 * h * h * (wdd0[j] + wdd1[j])
+                wd1[j] = kw[0, j] + 0.5 * h * lam1[j] / mass[p]
+            w1[j] = kw[1, j] + 0.5 * h * wd1[j]
             s1[j] = wd1[j] - vn1[j]
         if not stuck[p]:
             a += 1

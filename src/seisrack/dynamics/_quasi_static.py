@@ -42,6 +42,23 @@ QUASI_STATIC_SHIFT = 0.1
 _CACHE: dict = {}
 
 
+def rides_stiff(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float) -> bool:  # noqa: N803
+    """Whether the rack with every pallet stuck on it is too stiff for the step: its lowest
+    frequency (``diag(ω²)`` against the mass ``I + Pᵀ m P`` of the mass-orthonormal basis)
+    times ``dt`` exceeds ``QUASI_STATIC_OMEGA_DT``. Then no direction that carries a pallet is
+    resolved by the step, and where the kernel integrates every direction (hinges, P-Δ,
+    coupling damping: no direction can be held quasi-statically) it takes composite steps
+    throughout (``_planar_stage.py``)."""
+    r = w2.shape[0]
+    if r == 0:
+        return False
+    m2 = np.repeat(np.asarray(mass, dtype=float), 2)
+    A = np.eye(r) + P.T @ (m2[:, None] * P)
+    low = scipy.linalg.eigh(np.diag(np.asarray(w2, dtype=float)), A, eigvals_only=True,
+                            subset_by_index=[0, 0])[0]
+    return bool(low * dt * dt > QUASI_STATIC_OMEGA_DT**2)
+
+
 def stiff_directions(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float,  # noqa: N803
                      coupled: bool) -> np.ndarray:
     """(r,) bool: the directions held quasi-statically. Candidates: the directions whose

@@ -19,7 +19,7 @@ import numpy as np
 
 from seisrack.dynamics._blas import one_blas_thread
 from seisrack.dynamics._chunk import Chunk
-from seisrack.dynamics._quasi_static import QuasiStatic, stiff_directions
+from seisrack.dynamics._quasi_static import QuasiStatic, rides_stiff, stiff_directions
 from seisrack.dynamics._store import keep_index
 from seisrack.dynamics.axial import no_axial
 from seisrack.dynamics.basis import Basis
@@ -101,8 +101,12 @@ def run_planar_scheme(
     mod, used = _kernel(backend)
     # the directions too stiff for the step are held quasi-statically (_quasi_static.py): the
     # kernel integrates the others
-    qs = QuasiStatic(stiff_directions(w2, P, sliders.mass, dt, bool(nh) or Co.size > 0
-                                      or hinges.axial is not None), pat, P, w2, dt)
+    integrated = bool(nh) or Co.size > 0 or hinges.axial is not None
+    qs = QuasiStatic(stiff_directions(w2, P, sliders.mass, dt, integrated), pat, P, w2, dt)
+    # where every direction is integrated and the rack is too stiff for the step, every step
+    # is composite (_planar_stage.py): L-stable, so the stiff directions carry no period-2h
+    # residue into the stuck pallets' forces
+    comp_steps = n_steps + 1 if integrated and rides_stiff(w2, P, sliders.mass, dt) else 0
     dyn = qs.dyn
     nk = nb - qs.count
     # writable: a read-only array (a compiled model's) is another numba specialisation
@@ -122,14 +126,14 @@ def run_planar_scheme(
     fac = np.full(1, -1.0)  # its step length (-1: none)
     HW = np.zeros((4, nh))
     ax = no_axial(nk) if hinges.axial is None else hinges.axial.reduced(phi)
-    e_state = np.zeros(5)
+    e_state = np.zeros(7)
     ev_time = np.empty(max_events + 1)
     ev_pallet = np.empty(max_events + 1, dtype=np.int64)
     ev_kind = np.empty(max_events + 1, dtype=np.int64)
     bufs = (np.empty((chunk + 1, nk)), np.empty((chunk + 1, nk)), np.empty((chunk + 1, nk)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, 2 * m)),
             np.empty((chunk + 1, 2 * m)), np.empty((chunk + 1, m), dtype=np.bool_),
-            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 6 if track_energy else 0)))
+            np.empty((chunk + 1, nh)), np.empty((chunk + 1, 7 if track_energy else 0)))
     full = tuple(np.empty((chunk + 1, nb)) for _ in range(3)) if qs.count else ()
     keep_idx = keep_index(n_steps, save_every)
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype)
@@ -150,7 +154,8 @@ def run_planar_scheme(
                 kd, cdk, Co, Pk, mass, mus, mud, float(dt), agx[rows], agz[rows], pext, N,
                 start > 0, T_state, S_state, stuck, dirn, S, A, fac, start * float(dt), left,
                 _MAX_SUBSTEPS, *outs[:7], ev_time[n_ev:], ev_pallet[n_ev:], ev_kind[n_ev:],
-                stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8], *ax)
+                stats, Q, h_th0, h_k, h_law, h_par, hst, HW, e_state, outs[7], outs[8], *ax,
+                comp_steps)
             n_ev += int(ne)
             n_sub += int(ns)
             status = int(st)
@@ -191,6 +196,8 @@ def run_planar_scheme(
     energy = {nm: ken[:, c].copy() for c, nm in
               enumerate(("input", "kinetic", "strain", "damping", "friction"))
               } if track_energy else {}
+    if track_energy and comp_steps:
+        energy["algorithmic"] = ken[:, 6].copy()
     if track_energy and hinges.axial is not None:  # its work apart: not a strain energy
         energy["p_delta"] = ken[:, 5].copy()
         energy["strain"] -= energy["p_delta"]

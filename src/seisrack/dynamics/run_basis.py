@@ -101,9 +101,15 @@ def _line_ritz(M, sliders: Sliders, r, rv, F, hinges):  # noqa: ANN001, ANN202, 
 PLANAR_RITZ_TOL = 1e-1
 PLANAR_RITZ_TARGET = 40
 #: with nonlinear hinges, each hinge's unit moment is a starting load too, compressed at this
-#: tolerance (a yielding hinge needs its own directions, as on a line: HINGE_RITZ_TOL)
+#: tolerance (a yielding hinge needs its own directions, as on a line: HINGE_RITZ_TOL); Krylov
+#: blocks are added up to 120 vectors: at 80 the stiff rack of tests/test_planar_stiff.py kept
+#: 3 blocks (78 vectors), whose inertial coupling of the pallets' supports released a stuck
+#: pallet at its neighbour's slip onset (peak +16.5 %, 6 slip phases against the rigid blocks'
+#: 3); with the 4th block (104) every pallet is within 0.09 % (docs/theory/planar_friction.md
+#: §10). The 3D paper rack with hinges goes from 78 to 104 vectors; the long racks' first
+#: block is larger than either target
 PLANAR_HINGE_RITZ_TOL = HINGE_RITZ_TOL
-PLANAR_HINGE_RITZ_TARGET = 80
+PLANAR_HINGE_RITZ_TARGET = 120
 
 
 def _planar_ritz(M, sliders: PlanarSliders, influence, rv, hinges):  # noqa: ANN001, ANN202, N803
