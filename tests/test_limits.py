@@ -146,9 +146,25 @@ def test_a_ritz_basis_too_large_to_prepare_is_refused_by_name():
     with pytest.raises(InputError) as exc:
         limits.check_run(est, n_record=2001, n_pad=0, save_every=None, budget=4 * 2**30)
     assert exc.value.field == "rack" and "--engine local" in str(exc.value)
-    local = limits.estimate_run(**kw, ritz=False)
+    local = limits.estimate_run(**kw, engine="local")
     assert local.prep_memory == 0.0
     limits.check_run(local, n_record=2001, n_pad=0, save_every=None, budget=4 * 2**30)
+
+
+def test_the_local_engine_is_priced_as_itself():
+    """``--engine local`` on the 40 x 8 row (20,836 DOFs, 960 pallets, 20 s of the EC8 pair at
+    5 ms): measured 401.4 s CPU (``benchmarks/results/rack_row.md``, 2026-11-28); the default
+    engine's price of the same run (about 2 min) is what the CLI announced before."""
+    kw = {"n_record": 2001, "k": 2, "n_pad": 0, "n_dof": 20_836, "n_pallets": 960,
+          "n_levels": 8, "save_every": None, "three_d": True}
+    local = limits.estimate_run(**kw, engine="local")
+    default = limits.estimate_run(**kw)
+    assert 401.4 / 1.5 < local.seconds < 401.4 * 1.5, local.seconds
+    assert default.seconds < local.seconds / 2
+    # the 150-pallet example (10 x 5, 3,364 DOFs): 49.6 s measured
+    small = limits.estimate_run(**{**kw, "n_dof": 3_364, "n_pallets": 150, "n_levels": 5},
+                                engine="local")
+    assert 49.6 / 1.5 < small.seconds < 49.6 * 1.5, small.seconds
 
 
 def test_run_memory_estimate_against_tracemalloc():

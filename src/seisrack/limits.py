@@ -88,6 +88,16 @@ STEP_S_PER_BASIS = 2.0e-8
 #: [s] the Ritz basis's preparation per n_dof x (load patterns)²: its Gram matrix and the
 #: patterns' static responses (40 x 8 row, 20,836 DOFs, 1,923 patterns: 14 s)
 PREP_S_PER_NK2 = 2.0e-10
+#: [s] the local engine (``--engine local``) per pallet and analysis step: its cost grows with
+#: the pallets and the rack's length, not with a global basis. Measured on 20 s of the EC8 pair
+#: at 5 ms (4,000 steps, ``benchmarks/results/rack_row.md``, 2026-11-28): 10 x 5 (150 pallets)
+#: 49.6 s, 20 x 5 117 s, 40 x 5 258 s, 20 x 12 310 s, 40 x 8 (960 pallets) 401 s, 80 x 5
+#: (1,200) 709 s: 83 to 148 µs a pallet-step, 105-108 µs on the 40 x 5, 40 x 8 and 20 x 12 rows.
+#: On a line (2D) a pallet has one direction: the 2D warehouse example (400 pallets) 6.2 s
+LOCAL_STEP_S_PER_PALLET = 1.1e-4
+LOCAL_STEP_S_PER_PALLET_2D = 4.0e-6
+#: [s] the local basis's preparation per DOF (40 x 8 row, 20,836 DOFs: 3.1 s)
+LOCAL_PREP_S_PER_DOF = 1.5e-4
 
 # ---------------------------------------------------------------------------- modal analysis
 #: Most modes a command computes: far more than any participation criterion needs (EN 1998-1
@@ -256,7 +266,8 @@ class RunEstimate:
 
 def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: int,
                  n_levels: int, save_every: int | None, vertical: bool = False,
-                 three_d: bool = False, n_design: int = 0, ritz: bool = True) -> RunEstimate:
+                 three_d: bool = False, n_design: int = 0,
+                 engine: str = "default") -> RunEstimate:
     """Estimate a time history of ``n_record`` record samples (``k`` analysis steps each),
     ``n_pad`` samples of free vibration, on a rack of ``n_dof`` DOFs and ``n_pallets``.
 
@@ -269,9 +280,11 @@ def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: in
     is written): they, and the written dataset's copy of every history with them, count
     too. Above 50 DOFs the Ritz basis's preparation (the static responses of the load
     patterns, (n_dof, p), and their Gram matrix, p = one pattern per pallet and direction) is
-    freed before the run: the larger of the two counts (``ritz``: False for an engine that
-    builds no such basis, the local one).
+    freed before the run: the larger of the two counts. ``engine`` "local" (``--engine
+    local``) builds no such basis: its time is its own per pallet and step
+    (``LOCAL_STEP_S_PER_PALLET``) and its basis's preparation per DOF.
     """
+    ritz = engine != "local"
     n_steps = max(0, (n_record - 1 + n_pad) * k)
     n_t = n_steps + 1
     nb = n_dof if n_dof <= 50 else min(n_dof, BASIS_ESTIMATE)
@@ -290,6 +303,9 @@ def estimate_run(*, n_record: int, k: int, n_pad: int, n_dof: int, n_pallets: in
                   else STEP_S_PER_PALLET)
     per_step = STEP_S + per_pallet * n_pallets + STEP_S_PER_BASIS * nb
     seconds = n_steps * per_step + PREP_S_PER_NK2 * n_dof * n_pat * n_pat
+    if not ritz:
+        per_pallet = LOCAL_STEP_S_PER_PALLET if three_d else LOCAL_STEP_S_PER_PALLET_2D
+        seconds = n_steps * (STEP_S + per_pallet * n_pallets) + LOCAL_PREP_S_PER_DOF * n_dof
     return RunEstimate(n_steps=n_steps, n_keep=n_keep, memory=memory,
                        seconds=seconds, series_memory=series, prep_memory=prep)
 

@@ -253,7 +253,7 @@ def check_run_size(args: argparse.Namespace, model: Any, motion: Any) -> None:
                        n_pallets=model.n_pallets, n_levels=n_lev,
                        save_every=args.save_every, vertical=motion.v is not None,
                        three_d=model.ndm == 3, n_design=n_design,
-                       ritz=getattr(args, "engine", "default") != "local")
+                       engine=getattr(args, "engine", "default"))
     check_run(est, n_record=motion.n, n_pad=n_pad, save_every=args.save_every)
     if est.seconds * (2 if getattr(args, "rigid_check", False) else 1) > ANNOUNCE_S:
         print(f"seisrack: estimated: {est.describe()} (one core)", file=sys.stderr)
