@@ -42,13 +42,22 @@ QUASI_STATIC_SHIFT = 0.1
 _CACHE: dict = {}
 
 
+#: A rack whose lowest frequency with every pallet stuck, times the step, exceeds this (fewer
+#: than 2π steps per period) rides stiff (:func:`rides_stiff`). At 4 (the threshold above) the
+#: stiff rack of ``tests/test_planar_stiff.py`` with hinges (first period 1.48 ms) went back
+#: to the trapezoidal rule below dt = 0.94 ms and rang there: peaks +70 % and +91 % against
+#: the rigid blocks, 91-200 slip phases against 1-10, at 0.625 and 0.3125 ms; with composite
+#: steps within 0.5 % (docs/theory/planar_friction.md §10)
+RIDES_STIFF_OMEGA_DT = 1.0
+
+
 def rides_stiff(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float) -> bool:  # noqa: N803
     """Whether the rack with every pallet stuck on it is too stiff for the step: its lowest
     frequency (``diag(ω²)`` against the mass ``I + Pᵀ m P`` of the mass-orthonormal basis)
-    times ``dt`` exceeds ``QUASI_STATIC_OMEGA_DT``. Then no direction that carries a pallet is
-    resolved by the step, and where the kernel integrates every direction (hinges, P-Δ,
-    coupling damping: no direction can be held quasi-statically) it takes composite steps
-    throughout (``_planar_stage.py``)."""
+    times ``dt`` exceeds ``RIDES_STIFF_OMEGA_DT``: the step does not resolve its fundamental,
+    and the directions that carry the pallets are stiffer still. Where the kernel integrates
+    every direction (hinges, P-Δ, coupling damping: no direction can be held quasi-statically)
+    it then takes composite steps throughout (``_planar_stage.py``)."""
     r = w2.shape[0]
     if r == 0:
         return False
@@ -56,7 +65,7 @@ def rides_stiff(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float) -> b
     A = np.eye(r) + P.T @ (m2[:, None] * P)
     low = scipy.linalg.eigh(np.diag(np.asarray(w2, dtype=float)), A, eigvals_only=True,
                             subset_by_index=[0, 0])[0]
-    return bool(low * dt * dt > QUASI_STATIC_OMEGA_DT**2)
+    return bool(low * dt * dt > RIDES_STIFF_OMEGA_DT**2)
 
 
 def stiff_directions(w2: np.ndarray, P: np.ndarray, mass: np.ndarray, dt: float,  # noqa: N803
