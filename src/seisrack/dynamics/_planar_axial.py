@@ -42,7 +42,7 @@ def _axial_force(AA, AG, Ao, As, Ac, q, dn, gw, out):
 
 
 @_JIT
-def _trial_ax(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1,
+def _trial_ax(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn, ag1,
               pext1, N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
               Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW,
               AA, AG, Ao, As, Ac, AXW, dn, gw):
@@ -50,7 +50,7 @@ def _trial_ax(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, di
     the fixed point of the module docstring; returns 3 when it does not settle within
     ``_AXIAL_MAX`` passes. ``AXW`` (4, r) is scratch. Without factors: one plain trial."""
     if AG.shape[0] == 0:
-        return _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn,
+        return _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn,
                       ag1, pext1, N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm,
                       fac, Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW)
     r = kd.shape[0]
@@ -67,7 +67,7 @@ def _trial_ax(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, di
     for _it in range(_AXIAL_MAX):
         for i in range(r):
             pe[i] = pext1[i] - f[i]
-        ok = _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1,
+        ok = _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn, ag1,
                     pe, N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dqs, w, fac,
                     Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW)
         if ok != 0:

@@ -75,7 +75,7 @@ def _step(H, comp, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, 
     end state's. Returns ``_trial_ax``'s status."""
     if not comp:
         _trap_rel(H, T0, S0, ag1, kq, kw)
-        return _trial_ax(H, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn,
+        return _trial_ax(H, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn,
                          ag1, pext1, N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start,
                          warm, fac, Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW,
                          AA, AG, Ao, As, Ac, AXW, dn, gw)
@@ -85,7 +85,7 @@ def _step(H, comp, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, 
     _trap_rel(hm, T0, S0, ag_m, kq, kw)
     for i in range(dqp.shape[0]):
         dqp[i] = hm * T0[1, i] + 0.5 * hm * hm * T0[2, i]
-    ok = _trial_ax(hm, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn,
+    ok = _trial_ax(hm, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn,
                    ag_m, pe_m, N_m, Tm, Sm, e, tolF, dt, W, A, G, PF, stats, dqp, True, fac,
                    Q, hth0, hk, hlaw, hpar, hst_c, hst_m, hz_c, hM, hz_m, HW,
                    AA, AG, Ao, As, Ac, AXW, dn, gw)
@@ -96,7 +96,7 @@ def _step(H, comp, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, 
     for i in range(dqp.shape[0]):
         dqp[i] = hr * Tm[1, i] + 0.5 * hr * hr * Tm[2, i]
     # the same step matrix as the first stage's (c₃ = 2/(γH)): Newton goes on with its factor
-    return _trial_ax(hm, kq, kw, kd, cd, Co, P, mass, mus, mud, S, Tm, Sm, N_m, stuck, dirn,
+    return _trial_ax(hm, kq, kw, kd, cd, Co, P, mass, mus, mud, S, Tm, N_m, stuck, dirn,
                      ag1, pext1, N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dqp, True, fac,
                      Q, hth0, hk, hlaw, hpar, hst_m, hst_t, hz_m, hM, hz, HW,
                      AA, AG, Ao, As, Ac, AXW, dn, gw)

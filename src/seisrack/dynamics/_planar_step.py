@@ -124,13 +124,14 @@ def _huber(yx, yz, cc, mp, h):
 
 
 @_JIT
-def _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, S0, N0, stuck, dirn, ag1, pext1,
+def _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn, ag1, pext1,
            N1, T1, S1, e, tolF, dt, W, A, G, PF, stats, dq_start, warm, fac,
            Q, hth0, hk, hlaw, hpar, hst_c, hst_t, hz_c, hM, hz, HW):
-    """One step with a fixed contact state, from (T0, S0) to (T1, S1): the trapezoidal rule
-    over ``h`` or a stage of the composite step (``_planar_stage.py``), given by its relations
-    (``v = 2/h``, ``a = v²``): ``q̇₁ = v Δq + kq[1]``, ``q̈₁ = a Δq + kq[0]``, a pallet's
-    ``ẇ₁ = (h/2) λ₁/m + kw[0]`` and ``w₁ = kw[1] + (h/2) ẇ₁``; equilibrium at the end.
+    """One step with a fixed contact state, from ``T0`` (the pallets' start state enters
+    through the relations) to (T1, S1): the trapezoidal rule over ``h`` or a stage of the
+    composite step (``_planar_stage.py``), given by its relations (``v = 2/h``, ``a = v²``):
+    ``q̇₁ = v Δq + kq[1]``, ``q̈₁ = a Δq + kq[0]``, a pallet's ``ẇ₁ = (h/2) λ₁/m + kw[0]`` and
+    ``w₁ = kw[1] + (h/2) ẇ₁``; equilibrium at the end.
 
     T rows: q, qd, qdd (r); S rows: w, wd, wdd, lam, s (relative velocity), vn (support
     velocity) (2m). Writes the event values ``e`` (positive when the state is violated) and
