@@ -135,3 +135,59 @@ def test_a_prepared_run_serves_its_own_engine_only():
     a = run_rack(model, rec, engine="local", prepared=local)
     b = run_rack(model, rec, engine="local")
     np.testing.assert_array_equal(a.pallet_sliding, b.pallet_sliding)
+
+
+def _elcentro_pair(seconds: float, scale: float = 1.0):
+    """El Centro N-S down-aisle and the same record 10 s later cross-aisle."""
+    from dataclasses import replace
+
+    from seisrack.motion.components import combine
+
+    rec = load_builtin_record("elcentro_1940_ns")
+    n = int(round(seconds / rec.dt)) + 1
+    a = replace(rec, accel=scale * rec.accel[:n])
+    b = replace(rec, accel=scale * np.roll(rec.accel, -1000)[:n])
+    return combine(a, b)
+
+
+def test_a_step_whose_iteration_fails_is_taken_with_its_start_contacts():
+    """The 3D paper rack with mu_s 0.15, mu_d 0.1 under the El Centro pair at dt 2.5 ms: at
+    t = 4.94 s four sliding pallets stop and restart inside one step, and neither Newton's
+    iteration nor the retry of §4.5 converges (the line search stalls near alpha = 0; until
+    2026-11-28 that stall was taken for convergence, with an impulse residual of 18 % of the
+    structure's inertia term and an energy error of 6.9e-6 of the input). The step is now
+    taken with every pallet's start contact (docs/theory/local_engine.md §4.6), reported, and
+    the balance closes. Reference: the default engine with every mode at the same step, an
+    independent integrator; on this rack at mu 0.15/0.1 the local engine is 3.7 % below it
+    with or without the fallback (60.4 mm before, 60.8 mm now, against 63.1 mm), so the
+    tolerance here is 5 % of the peak, not the 0.5 % of the mu 0.2 case above."""
+    from seisrack.model.spec import with_friction
+
+    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.15, 0.1))
+    mo = _elcentro_pair(5.5)
+    loc = run_rack(model, mo, dt=0.0025, engine="local")
+    work = loc.history.work
+    assert work["frozen_steps"] >= 1, work
+    assert loc.history.energy_error() < 1e-8
+    ref = run_rack(model, mo, dt=0.0025, basis="full")
+    pl, pr = loc.pallet_peak_sliding(), ref.pallet_peak_sliding()
+    assert pr.max() > 0.03
+    assert np.abs(pl - pr).max() <= 0.05 * pr.max(), (pl, pr)
+
+
+def test_a_pallet_left_behind_by_its_impulse_ends_the_step_sliding():
+    """A stuck pallet whose local solve has no root (a grazing onset with mu_d < mu_s: its
+    impulse jumps with the support's motion) and on whose jump the structure's iteration
+    converged: it ends the step sliding with the velocity its impulse gives it
+    (docs/theory/local_engine.md §4.6), instead of being set on its support with an impulse
+    that does not match, which broke the energy balance (1.75e-6 of the input on the 10 x 5
+    warehouse row, 20 s of the EC8 pair, from a handful of such steps). The 3D paper rack,
+    mu 0.25/0.2, the El Centro pair, 10 s, dt 2.5 ms has one such step; the balance closes."""
+    from seisrack.model.spec import with_friction
+
+    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.25, 0.2))
+    h = run_rack(model, _elcentro_pair(10.0), dt=0.0025, engine="local").history
+    assert h.work["slipped_at_step_end"] >= 1, h.work
+    assert h.energy_error() < 1e-8
+    slips = [e for e in h.events if e.kind == "slip"]
+    assert slips and all(0.0 <= e.time_s <= 10.0 for e in slips)

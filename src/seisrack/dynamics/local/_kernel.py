@@ -22,7 +22,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _btd_solve,
         _trsv_lower,
     )
-    from seisrack.dynamics.local._pallet import _pallet_solve
+    from seisrack.dynamics.local._pallet import _EV_SLIP, _pallet_solve
 
 STATUS_OK = 0
 STATUS_EVENT_OVERFLOW = 1
@@ -43,6 +43,9 @@ _NEWTON_LOOSE = 1e-6
 #: Newton stops when its step is below this fraction of the velocities (1e-11 cost a third
 #: more iterations than 1e-9 on the warehouse rack for no change of the results)
 _NEWTON_TOL = 1e-9
+#: a pallet whose local solution ends stuck but whose impulse leaves it behind its support by
+#: more than this fraction of its velocity scale ends the step sliding instead (see the commit)
+_STUCK_SLACK = 1e-9
 #: fields of a pallet's local solution (``_pallet_solve``'s ``out``)
 _NOUT = 19
 DEBUG = False
@@ -65,6 +68,8 @@ def _psd_row(D, p, mp):
     a = D[p, 0]
     b = 0.5 * (D[p, 1] + D[p, 2])
     c = D[p, 3]
+    if not (np.isfinite(a) and np.isfinite(b) and np.isfinite(c)):
+        a, b, c = mp, 0.0, mp  # a finite difference across a jump: the stuck pallet's
     tr = 0.5 * (a + c)
     dif = 0.5 * (a - c)
     rad = np.sqrt(dif * dif + b * b)
@@ -156,39 +161,48 @@ def _eval_pallets(dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, ag
                   t2, stats, want_D):
     """Every pallet's local solution for the structure's velocity change ``dv`` (warm
     started from the β already in its row of ``outs``; ∂J/∂y written when ``want_D``)."""
-    m = ps.shape[0]
-    for p in range(m):
-        s = ps[p]
-        o = offsets[s]
-        b = sizes[s]
-        yx = _support(P, p, o, b, dv, 0)
-        yz = _support(P, p, o, b, dv, 1) if nd == 2 else 0.0
-        row = outs[p]
-        # the support's reference accelerations of the two previous steps (the contact
-        # decisions' filter, _pallet.py), when both are of the pallet's present state
-        usef = nprev[p] >= 2
-        bpx = beta[p, 0]
-        bpz = beta[p, 1]
-        bqx = bpx - h * jerk[p, 2]
-        bqz = bpz - h * jerk[p, 3]
-        if stuck[p]:
-            fast = _pallet_solve(yx, yz, True, 0.0, 0.0, dirn[p, 0], dirn[p, 1], h, mass[p],
-                                 mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
-                                 agp1[1], jerk[p, 0], jerk[p, 1], bpx, bpz, bqx, bqz, usef,
-                                 0.0, 0.0, 0.0, nd, ev[p], row, False, want_D)
-            if fast:
-                continue
-        if gstamp[p] != stamp:
-            g11, g12, g22 = _own_compliance(Ld, P, p, s, b, nd, Dp, t1, t2)
-            Gc[p, 0] = g11
-            Gc[p, 1] = g12
-            Gc[p, 2] = g22
-            gstamp[p] = stamp
-        stats[3] += 1
-        _pallet_solve(yx, yz, stuck[p], sv[p, 0], sv[p, 1], dirn[p, 0], dirn[p, 1], h,
-                      mass[p], mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
-                      agp1[1], jerk[p, 0], jerk[p, 1], bpx, bpz, bqx, bqz, usef, Gc[p, 0],
-                      Gc[p, 1], Gc[p, 2], nd, ev[p], row, WARM, want_D)
+    for p in range(ps.shape[0]):
+        _eval_pallet(p, dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, agp0,
+                     agp1, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld, Dp,
+                     outs, ev, t1, t2, stats, want_D)
+
+
+@_JIT
+def _eval_pallet(p, dv, offsets, sizes, P, ps, nd, h, mass, mus, mud, Nk0, Nk1, agp0, agp1,
+                 stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld, Dp, outs, ev, t1,
+                 t2, stats, want_D):
+    """Pallet ``p``'s local solution into its row of ``outs`` (see ``_eval_pallets``)."""
+    s = ps[p]
+    o = offsets[s]
+    b = sizes[s]
+    yx = _support(P, p, o, b, dv, 0)
+    yz = _support(P, p, o, b, dv, 1) if nd == 2 else 0.0
+    row = outs[p]
+    # the support's reference accelerations of the two previous steps (the contact
+    # decisions' filter, _pallet.py), when both are of the pallet's present state
+    usef = nprev[p] >= 2
+    bpx = beta[p, 0]
+    bpz = beta[p, 1]
+    bqx = bpx - h * jerk[p, 2]
+    bqz = bpz - h * jerk[p, 3]
+    if stuck[p]:
+        fast = _pallet_solve(yx, yz, True, 0.0, 0.0, dirn[p, 0], dirn[p, 1], h, mass[p],
+                             mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
+                             agp1[1], jerk[p, 0], jerk[p, 1], bpx, bpz, bqx, bqz, usef,
+                             0.0, 0.0, 0.0, nd, ev[p], row, False, want_D)
+        if fast:
+            return
+    if gstamp[p] != stamp:
+        g11, g12, g22 = _own_compliance(Ld, P, p, s, b, nd, Dp, t1, t2)
+        Gc[p, 0] = g11
+        Gc[p, 1] = g12
+        Gc[p, 2] = g22
+        gstamp[p] = stamp
+    stats[3] += 1
+    _pallet_solve(yx, yz, stuck[p], sv[p, 0], sv[p, 1], dirn[p, 0], dirn[p, 1], h,
+                  mass[p], mus[p], mud[p], Nk0[p], Nk1[p], agp0[0], agp0[1], agp1[0],
+                  agp1[1], jerk[p, 0], jerk[p, 1], bpx, bpz, bqx, bqz, usef, Gc[p, 0],
+                  Gc[p, 1], Gc[p, 2], nd, ev[p], row, WARM, want_D)
 
 
 @_JIT
@@ -215,11 +229,13 @@ def _newton(k, maxit, freeze, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass
     """Newton's method on the step's residual from ``dv`` (with ``outs`` and ``R`` its
     evaluation), the factor ``Ld``, ``X`` of the Newton matrix given; ``freeze``: a stalled
     iteration freezes the contacts of pallets with events (``mus_k``). Returns (converged,
-    the last increment's size)."""
+    what the last step left of its way to the root: (1 − α) of it after a damped step, so
+    that a line search stalled near α = 0 is neither converged nor loose)."""
     N = dv.shape[0]
     m = ps.shape[0]
     converged = False
     prev = -1.0
+    left = -1.0  # the last step's distance to the root (what the loose acceptance reads)
     refac = False
     for _it in range(maxit):
         stats[1] += 1
@@ -318,7 +334,10 @@ def _newton(k, maxit, freeze, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass
         dvmax = 0.0
         for i in range(N):
             dvmax = max(dvmax, abs(dv[i]))
-        if alpha * dmax <= _NEWTON_TOL * max(vscale, dvmax) or dmax == 0.0:
+        # what is left of this step's way to the root: (1 − α) of it after a damped step (a
+        # line search that stops near α = 0 has not converged: its residual stands)
+        rem = max(alpha, 1.0 - alpha) * dmax
+        if rem <= _NEWTON_TOL * max(vscale, dvmax) or dmax == 0.0:
             converged = True
             break
         # the next step estimated from the contraction of the last two full steps (the
@@ -330,6 +349,7 @@ def _newton(k, maxit, freeze, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass
         if prev >= 0.0 and alpha * dmax > 0.2 * prev:
             refac = True
         prev = alpha * dmax
+        left = rem
         if DEBUG and k == DEBUG_STEP:
             print("it", _it, "dmax", dmax, "alpha", alpha, "g0", g0, "g1", g1)
             for p in range(m):
@@ -365,7 +385,7 @@ def _newton(k, maxit, freeze, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass
                           Gc, gstamp, stamp,
                           Le, Dp, outs, ev, t1, t2, stats, False)
             _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
-    return converged, prev
+    return converged, left
 
 
 @_JIT
@@ -383,6 +403,7 @@ def _onsets_in_turn(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, 
     N = dv.shape[0]
     m = ps.shape[0]
     stats[7] += 1
+    solves0 = stats[3]
     for p in range(m):
         mus_k[p] = _HELD if stuck[p] else mus[p]
         tried[p] = False
@@ -401,6 +422,7 @@ def _onsets_in_turn(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, 
                          Gc, gstamp, stamp, Le, Dp, Dn, Ld, X, Ld2, X2, outs, outs_n, ev, t1,
                          t2, stats, rhs, dv, R, Rn, dlt, tmp, vscale)
     if not conv:
+        stats[10] += stats[3] - solves0
         return False, prev
     last = prev
     for _r in range(m):
@@ -442,7 +464,97 @@ def _onsets_in_turn(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, 
                   agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp,
                   outs, ev, t1, t2, stats, False)
     _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+    stats[10] += stats[3] - solves0
     return True, last
+
+
+@_JIT
+def _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp0, agp1,
+                 stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld, Dp, outs, ev, t1,
+                 t2, stats):
+    """Every pallet with the contact of the start of the step (``_frozen_step``): a stuck
+    pallet held (``mus_k`` holds it), a sliding one at mu_d N along its start direction."""
+    m = ps.shape[0]
+    for p in range(m):
+        if stuck[p]:
+            _eval_pallet(p, dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                         agp0, agp1, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld,
+                         Dp, outs, ev, t1, t2, stats, False)
+            continue
+        s = ps[p]
+        o = offsets[s]
+        b = sizes[s]
+        row = outs[p]
+        f = mud[p] * 0.5 * h * (Nk0[p] + Nk1[p])
+        row[0] = -f * dirn[p, 0]
+        row[1] = -f * dirn[p, 1] if nd == 2 else 0.0
+        for c in range(2, 6):
+            row[c] = 0.0
+        yx = _support(P, p, o, b, dv, 0)
+        yz = _support(P, p, o, b, dv, 1) if nd == 2 else 0.0
+        s1x = sv[p, 0] + row[0] / mass[p] - 0.5 * h * (agp0[0] + agp1[0]) - yx
+        s1z = (sv[p, 1] + row[1] / mass[p] - 0.5 * h * (agp0[1] + agp1[1]) - yz) \
+            if nd == 2 else 0.0
+        row[6] = 0.0
+        row[7] = s1x
+        row[8] = s1z
+        sn = np.sqrt(s1x * s1x + s1z * s1z)
+        row[9] = s1x / sn if sn > 0.0 else dirn[p, 0]  # the direction it slides on
+        row[10] = s1z / sn if sn > 0.0 else dirn[p, 1]
+        row[11] = 0.5 * h * (sv[p, 0] + s1x)
+        row[12] = 0.5 * h * (sv[p, 1] + s1z)
+        row[13] = -mud[p] * Nk1[p] * dirn[p, 0]
+        row[14] = -mud[p] * Nk1[p] * dirn[p, 1] if nd == 2 else 0.0
+        row[15] = yx / h
+        row[16] = yz / h
+        row[17] = 0.0
+        row[18] = 0.0
+
+
+@_JIT
+def _frozen_step(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, mus_k, mud, Nk0,
+                 Nk1, agp, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp, Ld,
+                 X, outs, ev, t1, t2, stats, rhs, dv, R, dlt, dvp):
+    """The last resort of a step whose Newton iteration and retry both failed (theory §4.6):
+    every pallet keeps the contact of the start of the step, stuck ones held, sliding ones at
+    mu_d N along their start direction. Each impulse is then linear in the support's motion
+    (m y or a constant), so the step is a linear solve with the exact matrix; its events wait
+    for the next step (counted: ``stats[11]``). Returns False when that matrix is not positive
+    definite."""
+    N = dv.shape[0]
+    m = ps.shape[0]
+    stats[11] += 1
+    for p in range(m):
+        mus_k[p] = _HELD if stuck[p] else mus[p]
+        if stuck[p]:
+            Dp[p, 0] = mass[p]
+            Dp[p, 1] = 0.0
+            Dp[p, 2] = 0.0
+            Dp[p, 3] = mass[p] if nd == 2 else 0.0
+        else:
+            for c in range(4):
+                Dp[p, c] = 0.0
+    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
+    stats[2] += 1
+    if not _btd_factor(Hd, Ho, sizes, Ld, X):
+        return False
+    for i in range(N):
+        dv[i] = dvp[i]
+    for _it in range(2):  # linear: the second pass only removes round-off
+        _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
+                     agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le,
+                     Dp, outs, ev, t1, t2, stats)
+        _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+        for i in range(N):
+            dlt[i] = -R[i]
+        _btd_solve(Ld, X, sizes, offsets, dlt)
+        for i in range(N):
+            dv[i] += dlt[i]
+    _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
+                 agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp,
+                 outs, ev, t1, t2, stats)
+    _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+    return True
 
 
 @_JIT
@@ -605,7 +717,10 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 dvmax = max(dvmax, abs(dv[i]))
             if prev >= 0.0 and prev <= _NEWTON_LOOSE * max(vscale, dvmax):
                 stats[6] += 1
-            else:
+            elif not _frozen_step(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus,
+                                  mus_k, mud, Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta,
+                                  nprev, Gc, gstamp, stamp, Le, Dp, Ld, X, outs, ev, t1, t2,
+                                  stats, rhs, dv, R, dlt, dvp):
                 status = STATUS_NEWTON
                 break
         # commit: structure
@@ -632,12 +747,26 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             yz = _support(P, p, o, b, dv, 1) if nd == 2 else 0.0
             # end relative velocity from momentum (eq. 3.2): exact impulse balance
             end_stuck = row[6] > 0.5
+            s1x = sv[p, 0] + row[0] / mass[p] - Agx - yx
+            s1z = (sv[p, 1] + row[1] / mass[p] - Agz - yz) if nd == 2 else 0.0
+            slipped = False
             if end_stuck:
-                s1x = 0.0
-                s1z = 0.0
-            else:
-                s1x = sv[p, 0] + row[0] / mass[p] - Agx - yx
-                s1z = (sv[p, 1] + row[1] / mass[p] - Agz - yz) if nd == 2 else 0.0
+                # a pallet that ends stuck has the support's velocity, to the tolerance of its
+                # local solve; when its impulse leaves it more than _STUCK_SLACK behind, the
+                # local solve found no root (a grazing onset, where J jumps with y) and the
+                # structure converged on the jump: the pallet has slipped, and ends the step
+                # sliding with the velocity its impulse gives it (momentum and the energy
+                # balance stay exact; theory §4.6)
+                vs = abs(Agx) + abs(Agz) + abs(yx) + abs(yz) \
+                    + 0.5 * h * mus[p] * (Nk0[p] + Nk1[p]) / mass[p]
+                sn = np.sqrt(s1x * s1x + s1z * s1z)
+                if sn > _STUCK_SLACK * vs:
+                    end_stuck = False
+                    slipped = True
+                    stats[9] += 1
+                else:
+                    s1x = 0.0
+                    s1z = 0.0
             vbx = _support(P, p, o, b, vbar, 0)
             vbz = _support(P, p, o, b, vbar, 1) if nd == 2 else 0.0
             sbx = 0.5 * (sv[p, 0] + s1x)
@@ -663,6 +792,17 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             uu[p, 1] += row[12]
             lam[p, 0] = row[13]
             lam[p, 1] = row[14]
+            if slipped:  # sliding from the end of the step, against its velocity
+                sn = np.sqrt(s1x * s1x + s1z * s1z)
+                dirn[p, 0] = s1x / sn
+                dirn[p, 1] = s1z / sn
+                lam[p, 0] = -mud[p] * Nk1[p] * dirn[p, 0]
+                lam[p, 1] = -mud[p] * Nk1[p] * dirn[p, 1]
+                if n_ev < max_events:
+                    ev_time[n_ev] = t_k + h
+                    ev_pallet[n_ev] = p
+                    ev_kind[n_ev] = _EV_SLIP
+                n_ev += 1
             # the support's reference acceleration and its rate (jerk) for the next step:
             # the minmod of the last two differences, so that a jump of the support's
             # acceleration (a neighbour's event) does not become a spurious jerk; after an
@@ -681,12 +821,17 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 if nprev[p] >= 1:
                     jlast[p, d] = dj
                 beta[p, d] = row[15 + d]
-            if row[17] > 0.0 or end_stuck != was_stuck:
+            if row[17] > 0.0 or end_stuck != was_stuck or slipped:
                 nprev[p] = 0
             else:
                 nprev[p] += 1
             for c in range(4):
                 Dp[p, c] = row[2 + c]
+            if slipped:  # its ∂J/∂y was taken across the jump: the stuck one instead
+                Dp[p, 0] = mass[p]
+                Dp[p, 1] = 0.0
+                Dp[p, 2] = 0.0
+                Dp[p, 3] = mass[p] if nd == 2 else 0.0
         energy[0] += e_in
         energy[1] += e_damp
         energy[2] += e_fr

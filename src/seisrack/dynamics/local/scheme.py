@@ -115,7 +115,7 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
     acc = np.empty((chunk + 1, nq))  # the central differences of v
     kept = [np.empty((keep_idx.size,) + b.shape[1:], dtype=b.dtype) for b in (*bufs, acc)]
     v_prev = None
-    stats = np.zeros(9, dtype=np.int64)
+    stats = np.zeros(12, dtype=np.int64)
     status, n_ev, start = 0, 0, 0
     limiter = blas_controller().limit(limits=1, user_api="blas")
     try:
@@ -166,7 +166,8 @@ def run_local_scheme(M, sliders: LocalSliders, basis: LocalBasis, *,  # noqa: AN
         backend=used, basis=described,
         work=dict(zip(("steps", "newton_iterations", "factorisations", "local_solves",
                        "line_search_evaluations", "frozen_contacts", "loose_steps",
-                       "retried_steps", "placed_onsets"),
+                       "retried_steps", "placed_onsets", "slipped_at_step_end",
+                       "retry_local_solves", "frozen_steps"),
                       (int(x) for x in stats),
                       strict=True)))
 
