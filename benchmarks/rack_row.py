@@ -203,24 +203,29 @@ def _report(rows, seconds, commit, load0, load1, elapsed, fit) -> str:  # noqa: 
         "+ damping + friction)| / max input.",
         "",
         "| rack | engine | DOFs | pallets | basis (largest block) | basis error | basis CPU | "
-        "events | Newton its | factorisations | local solves | falls | peak sliding | "
-        "energy error | run CPU | wall | peak memory |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "events | Newton its | factorisations | local solves (in retries) | "
+        "inexact: frozen contacts / slipped at step end / frozen steps | falls | "
+        "peak sliding | energy error | run CPU | wall | peak memory |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for label, eng, r in rows:
         if "error" in r and "cpu" not in r:
             lines.append(f"| {label} | {eng} | – | – | – | – | – | – | – | – | – | – | – | – | "
-                         f"failed: {r['error']} | – | – |")
+                         f"– | failed: {r['error']} | – | – |")
             continue
         w = r.get("work", {})
         blk = f" ({r['block']})" if "block" in r else ""
         be = f"{r['basis_error']:.3f}" if r.get("basis_error") is not None else "–"
         bc = f"{r['basis_cpu']:.1f} s" if "basis_cpu" in r else "–"
         en = f"{r['energy']:.1e}" if r.get("energy") is not None else "–"
+        ls = f"{w['local_solves']} ({w.get('retry_local_solves', '–')})" \
+            if "local_solves" in w else "–"
+        inexact = (f"{w['frozen_contacts']} / {w.get('slipped_at_step_end', '–')} / "
+                   f"{w.get('frozen_steps', '–')}") if "frozen_contacts" in w else "–"
         lines.append(
             f"| {label} | {eng} | {r['dofs']} | {r['pallets']} | {r['basis']}{blk} | {be} | "
             f"{bc} | {r['events']} | {w.get('newton_iterations', '–')} | "
-            f"{w.get('factorisations', '–')} | {w.get('local_solves', '–')} | {r['falls']} | "
+            f"{w.get('factorisations', '–')} | {ls} | {inexact} | {r['falls']} | "
             f"{r['peak'] * 1e3:.1f} mm | {en} | {r['cpu']:.1f} s | {r['wall']:.1f} s | "
             f"{r['max_rss_mb']:.0f} MB |")
     lines.append("")
