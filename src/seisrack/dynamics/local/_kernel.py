@@ -62,6 +62,15 @@ def _support(P, p, s0, b, x, d):
 
 
 @_JIT
+def _stuck_row(D, p, mp, nd):
+    """Row p of D (m, 4): ∂J/∂y of a pallet stuck through the step, its mass (m I)."""
+    D[p, 0] = mp
+    D[p, 1] = 0.0
+    D[p, 2] = 0.0
+    D[p, 3] = mp if nd == 2 else 0.0
+
+
+@_JIT
 def _psd_row(D, p, mp):
     """Row p of D (m, 4), a 2 × 2 ∂J/∂y, symmetrised with its eigenvalues clipped to [0, m]
     (the pallet's own mass bounds a monotone part; a start-of-step matrix needs no more)."""
@@ -527,10 +536,7 @@ def _frozen_step(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, mus
     for p in range(m):
         mus_k[p] = _HELD if stuck[p] else mus[p]
         if stuck[p]:
-            Dp[p, 0] = mass[p]
-            Dp[p, 1] = 0.0
-            Dp[p, 2] = 0.0
-            Dp[p, 3] = mass[p] if nd == 2 else 0.0
+            _stuck_row(Dp, p, mass[p], nd)
         else:
             for c in range(4):
                 Dp[p, c] = 0.0
@@ -628,10 +634,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             for d in range(4):
                 jerk[p, d] = 0.0
             nprev[p] = 0
-            Dp[p, 0] = mass[p]
-            Dp[p, 1] = 0.0
-            Dp[p, 2] = 0.0
-            Dp[p, 3] = mass[p] if nd == 2 else 0.0
+            _stuck_row(Dp, p, mass[p], nd)
         for i in range(N):
             dvp[i] = 0.0
         rows[:, :, :] = 0.0
@@ -662,10 +665,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
         # Newton matrix with the pallets' D of the start state; factorised once a step
         for p in range(m):
             if stuck[p]:
-                Dp[p, 0] = mass[p]
-                Dp[p, 1] = 0.0
-                Dp[p, 2] = 0.0
-                Dp[p, 3] = mass[p] if nd == 2 else 0.0
+                _stuck_row(Dp, p, mass[p], nd)
             else:
                 _psd_row(Dp, p, mass[p])
                 if nd == 1:
@@ -828,10 +828,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             for c in range(4):
                 Dp[p, c] = row[2 + c]
             if slipped:  # its ∂J/∂y was taken across the jump: the stuck one instead
-                Dp[p, 0] = mass[p]
-                Dp[p, 1] = 0.0
-                Dp[p, 2] = 0.0
-                Dp[p, 3] = mass[p] if nd == 2 else 0.0
+                _stuck_row(Dp, p, mass[p], nd)
         energy[0] += e_in
         energy[1] += e_damp
         energy[2] += e_fr
