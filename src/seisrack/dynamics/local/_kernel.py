@@ -22,7 +22,7 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
         _btd_solve,
         _trsv_lower,
     )
-    from seisrack.dynamics.local._pallet import _EV_SLIP, _pallet_solve
+    from seisrack.dynamics.local._pallet import _EV_SLIP, _EV_STICK, _pallet_solve
 
 STATUS_OK = 0
 STATUS_EVENT_OVERFLOW = 1
@@ -481,86 +481,154 @@ def _onsets_in_turn(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, 
 def _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp0, agp1,
                  stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld, Dp, outs, ev, t1,
                  t2, stats):
-    """Every pallet with the contact of the start of the step (``_frozen_step``): a stuck
-    pallet held (``mus_k`` holds it), a sliding one at mu_d N along its start direction."""
+    """Every pallet in ``_frozen_step``: a stuck pallet held (``mus_k`` holds it); a sliding
+    one by the return map on its friction disc, as the planar engine (no support compliance,
+    the direction of the end of the step): with ``z`` its relative velocity at the end
+    without friction, it slides on with ``J = −m c ẑ`` when ``|z| > c = mu_d N̄ h / m``, else
+    it stops inside the step, ``J = −m z``. Returns the potential of the impulses,
+    ``Σ ψ_p`` with ``∂ψ_p/∂y_p = J_p`` (convex: the step's Newton iteration backtracks on
+    it)."""
     m = ps.shape[0]
+    psi = 0.0
     for p in range(m):
-        if stuck[p]:
-            _eval_pallet(p, dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
-                         agp0, agp1, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld,
-                         Dp, outs, ev, t1, t2, stats, False)
-            continue
         s = ps[p]
         o = offsets[s]
         b = sizes[s]
         row = outs[p]
-        f = mud[p] * 0.5 * h * (Nk0[p] + Nk1[p])
-        row[0] = -f * dirn[p, 0]
-        row[1] = -f * dirn[p, 1] if nd == 2 else 0.0
-        for c in range(2, 6):
-            row[c] = 0.0
         yx = _support(P, p, o, b, dv, 0)
         yz = _support(P, p, o, b, dv, 1) if nd == 2 else 0.0
-        s1x = sv[p, 0] + row[0] / mass[p] - 0.5 * h * (agp0[0] + agp1[0]) - yx
-        s1z = (sv[p, 1] + row[1] / mass[p] - 0.5 * h * (agp0[1] + agp1[1]) - yz) \
-            if nd == 2 else 0.0
-        row[6] = 0.0
-        row[7] = s1x
-        row[8] = s1z
-        sn = np.sqrt(s1x * s1x + s1z * s1z)
-        row[9] = s1x / sn if sn > 0.0 else dirn[p, 0]  # the direction it slides on
-        row[10] = s1z / sn if sn > 0.0 else dirn[p, 1]
-        row[11] = 0.5 * h * (sv[p, 0] + s1x)
-        row[12] = 0.5 * h * (sv[p, 1] + s1z)
-        row[13] = -mud[p] * Nk1[p] * dirn[p, 0]
-        row[14] = -mud[p] * Nk1[p] * dirn[p, 1] if nd == 2 else 0.0
+        Agx = 0.5 * h * (agp0[0] + agp1[0])
+        Agz = 0.5 * h * (agp0[1] + agp1[1]) if nd == 2 else 0.0
+        mp = mass[p]
+        if stuck[p]:
+            _eval_pallet(p, dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                         agp0, agp1, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Ld,
+                         Dp, outs, ev, t1, t2, stats, False)
+            _stuck_row(outs[:, 2:6], p, mp, nd)
+            psi += mp * (Agx * yx + Agz * yz + 0.5 * (yx * yx + yz * yz))
+            continue
+        zx = sv[p, 0] - Agx - yx
+        zz = (sv[p, 1] - Agz - yz) if nd == 2 else 0.0
+        zn = np.sqrt(zx * zx + zz * zz)
+        c = mud[p] * 0.5 * h * (Nk0[p] + Nk1[p]) / mp
+        s0n = np.sqrt(sv[p, 0] ** 2 + sv[p, 1] ** 2)
+        if zn > c:  # slides on
+            ex = zx / zn
+            ez = zz / zn
+            row[0] = -mp * c * ex
+            row[1] = -mp * c * ez
+            g = mp * c / zn
+            row[2] = g * (1.0 - ex * ex)
+            row[3] = -g * ex * ez
+            row[4] = row[3]
+            row[5] = g * (1.0 - ez * ez) if nd == 2 else 0.0
+            row[6] = 0.0
+            row[7] = zx - c * ex
+            row[8] = zz - c * ez
+            row[9] = ex
+            row[10] = ez
+            row[11] = 0.5 * h * (sv[p, 0] + row[7])
+            row[12] = 0.5 * h * (sv[p, 1] + row[8])
+            row[13] = -mud[p] * Nk1[p] * ex
+            row[14] = -mud[p] * Nk1[p] * ez
+            row[17] = 0.0
+            psi += mp * (c * zn - 0.5 * c * c)
+        else:  # stops inside the step, at about the share of its impulse that stops it
+            tau = h * min(s0n / max(c, 1e-300), 1.0)
+            row[0] = -mp * zx
+            row[1] = -mp * zz
+            _stuck_row(outs[:, 2:6], p, mp, nd)
+            row[6] = 1.0
+            row[7] = 0.0
+            row[8] = 0.0
+            row[9] = dirn[p, 0]
+            row[10] = dirn[p, 1]
+            row[11] = 0.5 * tau * sv[p, 0]
+            row[12] = 0.5 * tau * sv[p, 1]
+            row[13] = mp * (agp1[0] + yx / h)
+            row[14] = mp * (agp1[1] + yz / h) if nd == 2 else 0.0
+            row[17] = 1.0
+            ev[p, 0, 0] = tau
+            ev[p, 0, 1] = _EV_STICK
+            psi += 0.5 * mp * zn * zn
         row[15] = yx / h
         row[16] = yz / h
-        row[17] = 0.0
         row[18] = 0.0
+    return psi
+
+
+@_JIT
+def _frozen_potential(Ad, Ao, sizes, offsets, dv, rhs, tmp, psi):
+    """½ dvᵀ A dv − rhsᵀ dv + Σ ψ_p: the potential whose gradient is the step's residual."""
+    for i in range(dv.shape[0]):
+        tmp[i] = 0.0
+    _btd_matvec(Ad, Ao, sizes, offsets, dv, tmp, 1.0)
+    acc = psi
+    for i in range(dv.shape[0]):
+        acc += dv[i] * (0.5 * tmp[i] - rhs[i])
+    return acc
 
 
 @_JIT
 def _frozen_step(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus, mus_k, mud, Nk0,
                  Nk1, agp, stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp, Ld,
-                 X, outs, ev, t1, t2, stats, rhs, dv, R, dlt, dvp):
+                 X, outs, ev, t1, t2, stats, rhs, dv, R, dlt, dvp, tmp, dvs, vscale):
     """The last resort of a step whose Newton iteration and retry both failed (theory §4.6):
-    every pallet keeps the contact of the start of the step, stuck ones held, sliding ones at
-    mu_d N along their start direction. Each impulse is then linear in the support's motion
-    (m y or a constant), so the step is a linear solve with the exact matrix; its events wait
-    for the next step (counted: ``stats[11]``). Returns False when that matrix is not positive
-    definite."""
+    every pallet stuck at the start is held through the step, every sliding one follows the
+    return map on its friction disc without the support's compliance (``_eval_frozen``).
+    The impulses are then the gradient of a convex potential, monotone in the support's
+    motion, and Newton's method with backtracking on that potential converges. Slip onsets
+    wait for the next step, whose local solves see them already due at τ = 0 (counted:
+    ``stats[11]``). Returns False when the step matrix is not positive definite or the
+    iteration does not converge."""
     N = dv.shape[0]
     m = ps.shape[0]
     stats[11] += 1
     for p in range(m):
         mus_k[p] = _HELD if stuck[p] else mus[p]
-        if stuck[p]:
-            _stuck_row(Dp, p, mass[p], nd)
-        else:
-            for c in range(4):
-                Dp[p, c] = 0.0
-    _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
-    stats[2] += 1
-    if not _btd_factor(Hd, Ho, sizes, Ld, X):
-        return False
     for i in range(N):
         dv[i] = dvp[i]
-    for _it in range(2):  # linear: the second pass only removes round-off
-        _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
-                     agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le,
-                     Dp, outs, ev, t1, t2, stats)
+    for _it in range(_RETRY_MAX):
+        stats[1] += 1
+        psi = _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                           agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp,
+                           stamp, Le, Dp, outs, ev, t1, t2, stats)
         _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
+        for p in range(m):
+            for c in range(4):
+                Dp[p, c] = outs[p, 2 + c]
+        _assemble_H(Ad, Ao, Hd, Ho, sizes, P, ps, Dp, nd)
+        stats[2] += 1
+        if not _btd_factor(Hd, Ho, sizes, Ld, X):
+            return False
         for i in range(N):
             dlt[i] = -R[i]
         _btd_solve(Ld, X, sizes, offsets, dlt)
+        dmax = 0.0
+        dvmax = 0.0
+        slope = 0.0
         for i in range(N):
-            dv[i] += dlt[i]
-    _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1, agp[k],
-                 agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc, gstamp, stamp, Le, Dp,
-                 outs, ev, t1, t2, stats)
-    _residual(Ad, Ao, sizes, offsets, dv, rhs, P, ps, nd, outs, R)
-    return True
+            dmax = max(dmax, abs(dlt[i]))
+            dvmax = max(dvmax, abs(dv[i]))
+            slope += R[i] * dlt[i]
+        if dmax <= _NEWTON_TOL * max(vscale, dvmax):
+            return True  # the last evaluation (at dv) stands
+        phi0 = _frozen_potential(Ad, Ao, sizes, offsets, dv, rhs, tmp, psi)
+        for i in range(N):
+            dvs[i] = dv[i]
+        alpha = 1.0
+        for _ls in range(30):
+            for i in range(N):
+                dv[i] = dvs[i] + alpha * dlt[i]
+            psi = _eval_frozen(dv, offsets, sizes, P, ps, nd, h, mass, mus_k, mud, Nk0, Nk1,
+                               agp[k], agp[k + 1], stuck, sv, dirn, jerk, beta, nprev, Gc,
+                               gstamp, stamp, Le, Dp, outs, ev, t1, t2, stats)
+            phi = _frozen_potential(Ad, Ao, sizes, offsets, dv, rhs, tmp, psi)
+            # Armijo, with room for the round-off of the potential's large linear part
+            if phi <= phi0 + 1e-4 * alpha * slope + 1e-13 * abs(phi0):
+                break
+            alpha *= 0.5
+    return False
 
 
 @_JIT
@@ -720,7 +788,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             elif not _frozen_step(k, Ad, Ao, Hd, Ho, sizes, offsets, P, ps, nd, h, mass, mus,
                                   mus_k, mud, Nk0, Nk1, agp, stuck, sv, dirn, jerk, beta,
                                   nprev, Gc, gstamp, stamp, Le, Dp, Ld, X, outs, ev, t1, t2,
-                                  stats, rhs, dv, R, dlt, dvp):
+                                  stats, rhs, dv, R, dlt, dvp, tmp, dvs, vscale):
                 status = STATUS_NEWTON
                 break
         # commit: structure
