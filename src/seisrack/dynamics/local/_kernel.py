@@ -835,6 +835,17 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 else:
                     s1x = 0.0
                     s1z = 0.0
+            # a pallet held stuck through the step by a frozen contact or a retry (mus_k above
+            # its mu_s) whose end force is beyond mu_s N slips at the end of the step, from
+            # zero relative velocity: its onset is placed late (by less than a step, counted
+            # with the slips at step end), not lost; left held, it stayed stuck at up to
+            # 1.02 mu_s N for steps on end (theory §4.6)
+            released = False
+            if end_stuck and mus_k[p] > mus[p] \
+                    and row[13] * row[13] + row[14] * row[14] > (mus[p] * Nk1[p]) ** 2:
+                end_stuck = False
+                released = True
+                stats[9] += 1
             vbx = _support(P, p, o, b, vbar, 0)
             vbz = _support(P, p, o, b, vbar, 1) if nd == 2 else 0.0
             sbx = 0.5 * (sv[p, 0] + s1x)
@@ -871,6 +882,17 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                     ev_pallet[n_ev] = p
                     ev_kind[n_ev] = _EV_SLIP
                 n_ev += 1
+            if released:  # sliding from rest, away from the force that held it
+                fn = np.sqrt(row[13] * row[13] + row[14] * row[14])
+                dirn[p, 0] = -row[13] / fn
+                dirn[p, 1] = -row[14] / fn
+                lam[p, 0] = -mud[p] * Nk1[p] * dirn[p, 0]
+                lam[p, 1] = -mud[p] * Nk1[p] * dirn[p, 1]
+                if n_ev < max_events:
+                    ev_time[n_ev] = t_k + h
+                    ev_pallet[n_ev] = p
+                    ev_kind[n_ev] = _EV_SLIP
+                n_ev += 1
             # the support's reference acceleration and its rate (jerk) for the next step:
             # the minmod of the last two differences, so that a jump of the support's
             # acceleration (a neighbour's event) does not become a spurious jerk; after an
@@ -889,6 +911,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 if nprev[p] >= 1:
                     jlast[p, d] = dj
                 beta[p, d] = row[15 + d]
+            # a pallet held through the step decides its next step on its unfiltered force:
+            # the filter (the mean of two steps) lags, and would hide an onset the hold deferred
             if row[17] > 0.0 or end_stuck != was_stuck or slipped:
                 nprev[p] = 0
             else:
