@@ -55,6 +55,43 @@ def test_energy_balance():
     assert _codes(pl.energy_balance({"energy_balance_error": math.nan})) == ["energy_balance"]
 
 
+def test_stuck_friction():
+    assert pl.stuck_friction({"stuck_friction_ratio_max": 0.9986}) == []
+    assert pl.stuck_friction({"stuck_friction_ratio_max": pl.STUCK_FRICTION_RATIO_MAX}) == []
+    assert pl.stuck_friction({"stuck_friction_ratio_max": None}) == []
+    assert pl.stuck_friction({}) == []
+    w = pl.stuck_friction({"stuck_friction_ratio_max": 1.12})
+    assert _codes(w) == ["stuck_friction"] and w[0]["value"] == 1.12
+    assert "1.12 times mu_s N" in w[0]["message"] and "Coulomb" in w[0]["source"]
+    assert _codes(pl.stuck_friction({"stuck_friction_ratio_max": math.nan})) == [
+        "stuck_friction"]
+
+
+def test_stuck_friction_ratio_reads_held_samples_only():
+    """|friction| / (mu_s N) over the samples where a pallet is stuck and still stuck at the
+    next one: the sample of a slip onset (stuck, then sliding) holds the force just before
+    the release and is left out; a sliding pallet's force never counts."""
+    import numpy as np
+
+    from seisrack.analysis.response import RackResponse
+
+    stuck = np.array([[True, False], [True, False], [True, True], [False, True]])
+    force = np.array([[10.0, 99.0], [12.0, 99.0], [15.0, 30.0], [20.0, 40.0]])
+    fake = SimpleNamespace(
+        history=SimpleNamespace(stuck=stuck, normal=np.full((4, 2), 100.0)),
+        pallet_friction=np.stack([force, np.zeros_like(force)], axis=-1),
+        pallet_mu_static=np.array([0.125, 0.5]))
+    # pallet 1: 12 / 12.5 at the second sample (15 at the third is its onset); pallet 2:
+    # 40 / 50 at the last sample (stuck there, no next sample)
+    assert RackResponse.stuck_friction_ratio(fake) == pytest.approx(0.96)
+    fake.pallet_friction = force  # a 2D rack: no direction axis
+    assert RackResponse.stuck_friction_ratio(fake) == pytest.approx(0.96)
+    fake.history.stuck = np.zeros((0, 2), dtype=bool)
+    fake.history.normal = np.zeros((0, 2))
+    fake.pallet_friction = np.zeros((0, 2))
+    assert RackResponse.stuck_friction_ratio(fake) is None
+
+
 def test_rotation_and_drift():
     design = {"connector_rotation_rad": {"max_abs": 15520.527, "max_label": "L1-B1-left"},
               "interstorey_drift_ratio": {"max_abs": 1.03, "max_label": "S1"}}
@@ -96,7 +133,11 @@ def _near_critical(tmp_path: Path) -> Path:
 
 def test_paper_rack_has_no_warning(capsys):
     assert main(["run", str(PAPER_RACK), "--builtin", "elcentro_1940_ns", "--json"]) == 0
-    assert json.loads(capsys.readouterr().out)["warnings"] == []
+    out = json.loads(capsys.readouterr().out)
+    assert out["warnings"] == []
+    # Coulomb's law on the exact engine's output: stuck means within mu_s N (its event
+    # tolerance, 1e-10 of mu_s N, and the round-off of the recovery)
+    assert 0.9 < out["stuck_friction_ratio_max"] <= 1.0 + 1e-8
     assert main(["run", str(PAPER_RACK), "--builtin", "elcentro_1940_ns"]) == 0
     assert "Plausibility" not in capsys.readouterr().out
 

@@ -390,6 +390,7 @@ class RackResponse:
             "n_events": len(self.events),
             "n_slip_events": n_slip,
             "energy_balance_error": self.history.energy_error() if self.energy else None,
+            "stuck_friction_ratio_max": self.stuck_friction_ratio(),
             "energy_J": {k: float(v[-1]) for k, v in self.energy.items()},
             "impacts": [{"contact": describe_contact(i), "time_s": i.time_s,
                          "closing_speed_m_s": i.speed_m_s} for i in self.impacts],
@@ -398,6 +399,25 @@ class RackResponse:
         if self.n_dir > 1:
             out.update(self._falls_summary())
         return out
+
+    def stuck_friction_ratio(self) -> float | None:
+        """The largest friction force of a stuck pallet over its static capacity, |λ| /
+        (mu_s N), over the kept samples at which the pallet is stuck and still stuck at the next
+        sample (a sample at a slip onset holds the force just before the release). Coulomb's
+        law bounds it by 1; None without pallets or kept samples."""
+        h = self.history
+        f = np.asarray(self.pallet_friction, dtype=float)
+        st = np.asarray(h.stuck, dtype=bool)
+        n = np.asarray(h.normal, dtype=float)
+        if f.size == 0 or st.shape[0] == 0 or st.shape != n.shape or f.shape[:2] != st.shape:
+            return None
+        mag = np.abs(f) if f.ndim == 2 else np.linalg.norm(f, axis=-1)
+        held = st.copy()
+        held[:-1] &= st[1:]
+        cap = self.pallet_mu_static * n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(held & (cap > 0.0), mag / cap, 0.0)
+        return float(np.max(ratio)) if ratio.size else None
 
     def _falls_summary(self) -> dict[str, Any]:
         levels = sorted({int(v) for v in self.pallet_level})

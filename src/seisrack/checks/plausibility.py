@@ -36,12 +36,16 @@ ENERGY_ERROR_MAX = 1e-6
 #: connectors fail in the EN 15512 cantilever test; an elastic connector model says nothing
 #: physical there
 CONNECTOR_ROTATION_MAX = 0.2
+#: a stuck pallet's friction force over mu_s N: Coulomb's law bounds it by 1; the engines
+#: hold it to their event tolerance (1e-10 of mu_s N; tests/test_local_front.py); 1 % is an
+#: inexact contact decision the output shows, not round-off
+STUCK_FRICTION_RATIO_MAX = 1.01
 #: interstorey drift ratio: twice the 5 % "collapse prevention" transient drift of steel
 #: moment frames (FEMA 356, Table C1-3); beyond, the rack would have collapsed
 DRIFT_RATIO_MAX = 0.10
 
 __all__ = ["basis_cap", "critical_load", "energy_balance", "pallet_mass",
-           "plausibility_warnings", "response_extremes"]
+           "plausibility_warnings", "response_extremes", "stuck_friction"]
 
 
 def _warning(code: str, message: str, value: float, limit: float, source: str
@@ -162,6 +166,21 @@ def response_extremes(summary: Mapping[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
+def stuck_friction(summary: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """A pallet reported stuck with a friction force beyond :data:`STUCK_FRICTION_RATIO_MAX`
+    of its static capacity mu_s N."""
+    ratio = summary.get("stuck_friction_ratio_max")
+    if ratio is None or not isinstance(ratio, int | float) or ratio <= STUCK_FRICTION_RATIO_MAX:
+        return []
+    return [_warning(
+        "stuck_friction", f"a pallet is reported stuck with a friction force of {ratio:.4g} "
+        "times mu_s N, which Coulomb's law does not allow: the engine's contact decisions "
+        "were inexact there (a contact held through a step it could not resolve); compare "
+        "with a smaller --dt or the default engine", ratio if math.isfinite(ratio) else 1e300,
+        STUCK_FRICTION_RATIO_MAX,
+        "Coulomb's law (stuck: |friction| <= mu_s N)")]
+
+
 def plausibility_warnings(spec: Any = None, model: Any = None,
                           summary: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
     """Every warning that applies to what is given (each argument is optional)."""
@@ -171,7 +190,8 @@ def plausibility_warnings(spec: Any = None, model: Any = None,
     if model is not None:
         out += critical_load(getattr(model, "critical_load_factor", None))
     if summary is not None:
-        out += energy_balance(summary) + response_extremes(summary) + basis_cap(summary)
+        out += (energy_balance(summary) + response_extremes(summary) + basis_cap(summary)
+                + stuck_friction(summary))
     return out
 
 
