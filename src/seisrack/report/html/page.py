@@ -29,7 +29,8 @@ KNOWN_KEYS = {"record", "g_m_s2", "dt_s", "duration_s", "status", "peaks", "slid
               "outputs", "design_checks", "modal", "report", "seed", "hinges",
               "design_analysis", "sliding_reduction", "dimension", "directions", "impacts",
               "falls", "falls_by_level", "pallets_falling", "pallets_checked_for_falls",
-              "angle_deg", "notes", "design", "energy_J", "work", "warnings"}
+              "angle_deg", "notes", "design", "energy_J", "work", "warnings",
+              "stuck_friction_ratio_max"}
 
 
 def _figure(fig_id: str, src: str, caption: str) -> str:
