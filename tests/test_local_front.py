@@ -228,3 +228,22 @@ def test_a_pallet_held_past_its_onset_slips_at_the_end_of_the_step():
     assert first["local"] - first["ref"] <= dt, first
     assert loc.work["slipped_at_step_end"] >= 1, loc.work
     assert loc.energy_error() < 1e-8
+
+
+def test_a_pallet_reported_stuck_is_within_its_static_capacity():
+    """Coulomb's law on the local engine's output: a pallet reported stuck (and still stuck
+    at the next sample) carries at most mu_s N. The 3D paper rack at mu 0.2 under the El
+    Centro pair, dt 5 ms: at t = 3.65 s two pallets stick; in the next step their filtered
+    holding force releases them and their motion stops them at once, and until 2026-11-28
+    they were then held to the end of the step with no further onset, reported stuck at
+    1.387 mu_s N (docs/theory/local_engine.md §4.7). Their onsets for the rest of such a
+    step now read the unfiltered force."""
+    from seisrack.checks.plausibility import plausibility_warnings
+    from seisrack.model.spec import with_friction
+
+    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.2, 0.2))
+    r = run_rack(model, _elcentro_pair(4.0), dt=0.005, engine="local")
+    assert r.history.stuck.any() and not r.history.stuck.all()
+    assert r.stuck_friction_ratio() <= 1.0 + 1e-6
+    codes = [w["code"] for w in plausibility_warnings(summary=r.summary())]
+    assert "stuck_friction" not in codes
