@@ -871,21 +871,17 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             uu[p, 1] += row[12]
             lam[p, 0] = row[13]
             lam[p, 1] = row[14]
-            if slipped:  # sliding from the end of the step, against its velocity
-                sn = np.sqrt(s1x * s1x + s1z * s1z)
-                dirn[p, 0] = s1x / sn
-                dirn[p, 1] = s1z / sn
-                lam[p, 0] = -mud[p] * Nk1[p] * dirn[p, 0]
-                lam[p, 1] = -mud[p] * Nk1[p] * dirn[p, 1]
-                if n_ev < max_events:
-                    ev_time[n_ev] = t_k + h
-                    ev_pallet[n_ev] = p
-                    ev_kind[n_ev] = _EV_SLIP
-                n_ev += 1
-            if released:  # sliding from rest, away from the force that held it
-                fn = np.sqrt(row[13] * row[13] + row[14] * row[14])
-                dirn[p, 0] = -row[13] / fn
-                dirn[p, 1] = -row[14] / fn
+            if slipped or released:
+                # sliding from the end of the step: against its velocity (left behind by its
+                # impulse), or from rest away from the force that held it
+                if slipped:
+                    sn = np.sqrt(s1x * s1x + s1z * s1z)
+                    dirn[p, 0] = s1x / sn
+                    dirn[p, 1] = s1z / sn
+                else:
+                    fn = np.sqrt(row[13] * row[13] + row[14] * row[14])
+                    dirn[p, 0] = -row[13] / fn
+                    dirn[p, 1] = -row[14] / fn
                 lam[p, 0] = -mud[p] * Nk1[p] * dirn[p, 0]
                 lam[p, 1] = -mud[p] * Nk1[p] * dirn[p, 1]
                 if n_ev < max_events:
