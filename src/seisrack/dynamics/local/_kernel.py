@@ -839,7 +839,7 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             # its mu_s) whose end force is beyond mu_s N slips at the end of the step, from
             # zero relative velocity: its onset is placed late (by less than a step, counted
             # with the slips at step end), not lost; left held, it stayed stuck at up to
-            # 1.02 mu_s N for steps on end (theory §4.6)
+            # 1.008 mu_s N for five steps on the 3D paper rack (theory §4.7)
             released = False
             if end_stuck and mus_k[p] > mus[p] \
                     and row[13] * row[13] + row[14] * row[14] > (mus[p] * Nk1[p]) ** 2:
@@ -907,8 +907,6 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 if nprev[p] >= 1:
                     jlast[p, d] = dj
                 beta[p, d] = row[15 + d]
-            # a pallet held through the step decides its next step on its unfiltered force:
-            # the filter (the mean of two steps) lags, and would hide an onset the hold deferred
             if row[17] > 0.0 or end_stuck != was_stuck or slipped:
                 nprev[p] = 0
             else:
