@@ -198,7 +198,7 @@ def test_a_pallet_held_past_its_onset_slips_at_the_end_of_the_step():
     """A stuck pallet whose slip onset the step's iteration could not place (a grazing onset
     with mu_d < mu_s: frozen after 6 Newton iterations in two steps, then held by the retry
     of the next four, which failed) slips at the end of the step, its onset late by less
-    than a step; it is not held on at more than mu_s N (docs/theory/local_engine.md §4.6).
+    than a step; it is not held on at more than mu_s N (docs/theory/local_engine.md §4.7).
     Reference: the default engine with every mode, its onsets located inside the step
     (docs/theory/planar_friction.md §3).
     The 3D paper rack with mu_s 0.15, 0.153, 0.147, 0.156 (pallets 1-4; no two reach their
