@@ -151,29 +151,32 @@ def _elcentro_pair(seconds: float, scale: float = 1.0):
 
 
 def test_a_step_whose_iteration_fails_is_taken_with_its_start_contacts():
-    """The 3D paper rack with mu_s 0.15, mu_d 0.1 under the El Centro pair at dt 2.5 ms: at
-    t = 4.94 s four sliding pallets stop and restart inside one step, and neither Newton's
-    iteration nor the retry of §4.5 converges (the line search stalls near alpha = 0; until
-    2026-11-28 that stall was taken for convergence, with an impulse residual of 18 % of the
-    structure's inertia term and an energy error of 6.9e-6 of the input). The step is now
-    taken with the contacts of its start, the sliding pallets by the return map on their
-    friction discs (docs/theory/local_engine.md §4.6), reported, and the balance closes.
+    """The 3D paper rack with mu_s 0.15, mu_d 0.099 under the El Centro pair at dt 2.5 ms: at
+    t = 4.9375 s four sliding pallets stop inside one step, and neither Newton's iteration
+    nor the retry of §4.5 converges (the line search stalls near alpha = 0; until 2026-11-28
+    that stall was taken for convergence, with an impulse residual of 18 % of the
+    structure's inertia term and an energy error of 6.9e-6 of the input). The step is taken
+    with the contacts of its start, the sliding pallets by the return map on their friction
+    discs (docs/theory/local_engine.md §4.6), reported, and the balance closes. A pallet
+    that stops inside such a step and whose end force is beyond mu_s N slips at the step's
+    end (§4.7): it used to be reported stuck at 4.72 mu_s N here.
     Reference: the default engine with every mode at the same step, an independent
-    integrator; on this rack at mu 0.15/0.1 the local engine is 3-4 % below it with or
-    without the fallback (60.44 mm before, 60.56 mm now, against 63.14 mm), so the tolerance
-    here is 5 % of the peak, not the 0.5 % of the mu 0.2 case above."""
+    integrator: measured 0.75 % of the peak apart (61.84 against 62.31 mm). The tolerance is
+    2.5 %: with mu_d < mu_s the order of near-simultaneous onsets decides the rest of the run,
+    and a change of the record by 1e-5 moves the default engine's peak by 1.2 % (§4.7)."""
     from seisrack.model.spec import with_friction
 
-    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.15, 0.1))
+    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.15, 0.099))
     mo = _elcentro_pair(5.5)
     loc = run_rack(model, mo, dt=0.0025, engine="local")
     work = loc.history.work
     assert work["frozen_steps"] >= 1, work
     assert loc.history.energy_error() < 1e-8
+    assert loc.stuck_friction_ratio() <= 1.0 + 1e-6
     ref = run_rack(model, mo, dt=0.0025, basis="full")
     pl, pr = loc.pallet_peak_sliding(), ref.pallet_peak_sliding()
     assert pr.max() > 0.03
-    assert np.abs(pl - pr).max() <= 0.05 * pr.max(), (pl, pr)
+    assert np.abs(pl - pr).max() <= 0.025 * pr.max(), (pl, pr)
 
 
 def test_a_pallet_left_behind_by_its_impulse_ends_the_step_sliding():
@@ -183,11 +186,13 @@ def test_a_pallet_left_behind_by_its_impulse_ends_the_step_sliding():
     (docs/theory/local_engine.md §4.6), instead of being set on its support with an impulse
     that does not match, which broke the energy balance (1.75e-6 of the input on the 10 x 5
     warehouse row, 20 s of the EC8 pair, from a handful of such steps). The 3D paper rack,
-    mu 0.25/0.2, the El Centro pair, 10 s, dt 2.5 ms has one such step; the balance closes."""
+    mu 0.12/0.0792, the El Centro pair scaled by 0.7, 10 s, dt 5 ms has four such steps
+    (counted apart from the releases of §4.7 with a scratch counter, 2026-11-28); the
+    balance closes."""
     from seisrack.model.spec import with_friction
 
-    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.25, 0.2))
-    h = run_rack(model, _elcentro_pair(10.0), dt=0.0025, engine="local").history
+    model = compile_rack(with_friction(load_rack(PAPER_3D), 0.12, 0.0792))
+    h = run_rack(model, _elcentro_pair(10.0, 0.7), dt=0.005, engine="local").history
     assert h.work["slipped_at_step_end"] >= 1, h.work
     assert h.energy_error() < 1e-8
     slips = [e for e in h.events if e.kind == "slip"]
@@ -247,3 +252,23 @@ def test_a_pallet_reported_stuck_is_within_its_static_capacity():
     assert r.stuck_friction_ratio() <= 1.0 + 1e-6
     codes = [w["code"] for w in plausibility_warnings(summary=r.summary())]
     assert "stuck_friction" not in codes
+
+
+@pytest.mark.parametrize(("mus", "mud", "dt", "seconds", "before"),
+                         [(0.15, 0.1, 0.005, 9.0, 1.045), (0.25, 0.2, 0.0025, 5.0, 1.011)])
+def test_a_stuck_pallet_force_is_not_extrapolated_across_its_own_event(mus, mud, dt, seconds,
+                                                                       before):
+    """A stuck pallet's holding force over a step is extrapolated with the rate of its
+    support's acceleration (the jerk of docs/theory/local_engine.md §4.1), estimated from its
+    last two steps. Across the pallet's own event that rate belongs to the other contact
+    state: it is dropped, not carried on. Kept until 2026-11-28, it reported pallets 2 and 3
+    of the 3D paper rack stuck at ``before`` mu_s N (at 8.74 s and 4.665 s, three steps after
+    they stuck, under the El Centro pair). Reference: Coulomb's law, |lambda| <= mu_s N for a
+    stuck pallet."""
+    from seisrack.model.spec import with_friction
+
+    model = compile_rack(with_friction(load_rack(PAPER_3D), mus, mud))
+    r = run_rack(model, _elcentro_pair(seconds), dt=dt, engine="local")
+    assert r.history.stuck.any() and not r.history.stuck.all()
+    assert r.stuck_friction_ratio() <= 1.0 + 1e-6
+    assert r.history.energy_error() < 1e-8

@@ -836,12 +836,14 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                     s1x = 0.0
                     s1z = 0.0
             # a pallet held stuck through the step by a frozen contact or a retry (mus_k above
-            # its mu_s) whose end force is beyond mu_s N slips at the end of the step, from
-            # zero relative velocity: its onset is placed late (by less than a step, counted
-            # with the slips at step end), not lost; left held, it stayed stuck at up to
-            # 1.008 mu_s N for five steps on the 3D paper rack (theory §4.7)
+            # its mu_s), or stopped inside a frozen step's return map, whose end force is
+            # beyond mu_s N slips at the end of the step, from zero relative velocity: its
+            # onset is placed late (by less than a step, counted with the slips at step end),
+            # not lost; left held, it stayed stuck at up to 1.008 mu_s N for five steps on the
+            # 3D paper rack, and a stop in a frozen step was reported at 4.7 mu_s N (theory
+            # §4.7)
             released = False
-            if end_stuck and mus_k[p] > mus[p] \
+            if end_stuck and (mus_k[p] > mus[p] or not stuck[p]) \
                     and row[13] * row[13] + row[14] * row[14] > (mus[p] * Nk1[p]) ** 2:
                 end_stuck = False
                 released = True
@@ -893,7 +895,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
             # the minmod of the last two differences, so that a jump of the support's
             # acceleration (a neighbour's event) does not become a spurious jerk; after an
             # event of the pallet itself its reference changes, so no difference is taken
-            # across it (theory §4.1)
+            # across it and the jerk from before it is dropped (kept, it extrapolated the
+            # holding force to 1.045 mu_s N; theory §4.1, §4.7)
             for d in range(2):
                 dj = (row[15 + d] - beta[p, d]) / h
                 if nprev[p] >= 2:
@@ -909,6 +912,8 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                 beta[p, d] = row[15 + d]
             if row[17] > 0.0 or end_stuck != was_stuck or slipped:
                 nprev[p] = 0
+                jerk[p, 0] = 0.0
+                jerk[p, 1] = 0.0
             else:
                 nprev[p] += 1
             for c in range(4):
