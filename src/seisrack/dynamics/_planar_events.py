@@ -22,6 +22,11 @@ except NameError:  # pragma: no cover - plain import of this file (pure-Python t
     from seisrack.dynamics._planar_contact import _released_forces
     from seisrack.dynamics._planar_step import _s_update
 
+#: a stuck pallet frozen by the chatter guard at level 1 (``_CHATTER``) slips beyond
+#: (1 + this) mu_s N: well above the round-off of a force hovering at mu_s N
+_FROZEN_SLACK = 1e-5
+
+
 @_JIT
 def _start_values(stuck, mus, N0, S0, e_lo):
     """Event values at the start of a sub-step (the bracket's lo end)."""
@@ -75,9 +80,9 @@ def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, 
     their capacity: when several reach their threshold together, releasing one can unload the
     others (an all-at-once release chattered, each pallet re-sticking at once). Updates
     ``stuck``, ``dirn`` and ``S`` (the stuck pallets' mass); writes qdd, wdd and lam.
-    ``frozen`` pallets keep their state (see ``_CHATTER``). Damping: ``cd`` its diagonal,
-    ``Co`` the rest or (0, 0) (see ``_trial``). ``stats[2]`` counts the factorisations of
-    I + S (one, and one more after each release or re-stick).
+    ``frozen`` pallets keep their state (see ``_CHATTER``) unless ``forced``. Damping: ``cd``
+    its diagonal, ``Co`` the rest or (0, 0) (see ``_trial``). ``stats[2]`` counts the
+    factorisations of I + S (one, and one more after each release or re-stick).
     """
     r = kd.shape[0]
     m = mass.shape[0]
@@ -152,7 +157,7 @@ def _decide(kd, cd, Co, P, mass, mus, mud, S, T0, S0, ag, pext, N, stuck, dirn, 
             mag = np.sqrt(lam[2 * p] ** 2 + lam[2 * p + 1] ** 2)
             cap = mus[p] * N[p]
             ratio = mag / cap if cap > 0.0 else (np.inf if mag > 0.0 else 0.0)
-            if frozen[p]:
+            if frozen[p] and not forced[p]:
                 continue
             if forced[p]:
                 ratio += 1e-7 + 1e-12  # released from 1 - 1e-7 of the capacity
@@ -219,11 +224,15 @@ def _classify(stuck, dirn, mus, N, S0, e, cand, forced, old_stuck, turned, c_ful
         turned[p] = False
         jx = 2 * p
         jz = jx + 1
-        if frozen[p]:
+        if frozen[p] == 2 or (frozen[p] == 1 and not stuck[p]):
             continue
         if stuck[p]:
             mag = np.sqrt(lam[jx] ** 2 + lam[jz] ** 2)
-            if mag - mus[p] * N[p] > -1e-7 * mus[p] * N[p] - 1e-300:
+            if frozen[p] == 1:  # released only beyond its capacity, never re-decided
+                if mag > mus[p] * N[p]:
+                    forced[p] = True
+                    _slide_away(lam, dirn, p)
+            elif mag - mus[p] * N[p] > -1e-7 * mus[p] * N[p] - 1e-300:
                 forced[p] = True
                 _slide_away(lam, dirn, p)
             else:
@@ -310,10 +319,22 @@ def _snap_stops(P, S, mass, T0, S0, stuck, snap):
 
 
 @_JIT
-def _mask_frozen(frozen, e):
+def _mask_frozen(frozen, stuck, e):
+    """No event of a frozen pallet in the rest of the step (its event value masked), except
+    a stuck one's slip onset at level 1 (``_frozen_slack``)."""
     for p in range(e.shape[0]):
-        if frozen[p]:
+        if frozen[p] == 2 or (frozen[p] == 1 and not stuck[p]):
             e[p] = -1e300
+
+
+@_JIT
+def _frozen_slack(frozen, stuck, mus, N1, tolF):
+    """A stuck pallet frozen at level 1 slips when its force passes mu_s N by
+    ``_FROZEN_SLACK``: hovering at mu_s N (the Zeno sequence) is not an event, a force that
+    goes on rising is."""
+    for p in range(tolF.shape[0]):
+        if frozen[p] == 1 and stuck[p]:
+            tolF[p] = max(tolF[p], _FROZEN_SLACK * mus[p] * N1[p])
 
 
 @_JIT
