@@ -836,12 +836,12 @@ def run_local(Md, Cd, Kd, Mo, Co, Ko, sizes, offsets, P, ps, nd, mass, mus, mud,
                     s1x = 0.0
                     s1z = 0.0
             # a pallet held stuck through the step by a frozen contact or a retry (mus_k above
-            # its mu_s), or stopped inside a frozen step's return map, whose end force is
-            # beyond mu_s N slips at the end of the step, from zero relative velocity: its
-            # onset is placed late (by less than a step, counted with the slips at step end),
-            # not lost; left held, it stayed stuck at up to 1.008 mu_s N for five steps on the
-            # 3D paper rack, and a stop in a frozen step was reported at 4.7 mu_s N (theory
-            # §4.7)
+            # its mu_s), or stopped inside the step (mostly in a frozen step's return map),
+            # whose end force is beyond mu_s N slips at the end of the step, from zero
+            # relative velocity: its onset is placed late (by less than a step, counted with
+            # the slips at step end), not lost; left held, it stayed stuck at up to 1.008
+            # mu_s N for five steps on the 3D paper rack, and a stop in a frozen step was
+            # reported at 4.7 mu_s N (theory §4.7)
             released = False
             if end_stuck and (mus_k[p] > mus[p] or not stuck[p]) \
                     and row[13] * row[13] + row[14] * row[14] > (mus[p] * Nk1[p]) ** 2:
