@@ -14,7 +14,8 @@ included); and the rack's symmetry (pallets 1 and 4 are mirror images, as are 2 
 
 from __future__ import annotations
 
-from dataclasses import replace
+import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -22,17 +23,9 @@ from rack_inputs import EXAMPLES
 from seisrack.analysis import run_rack
 from seisrack.model import compile_rack, load_rack
 from seisrack.model.spec import with_friction
-from seisrack.motion import load_builtin_record
-from seisrack.motion.components import combine
 
-
-def _elcentro_pair(seconds: float, scale: float):
-    """El Centro N-S down-aisle and the same record 10 s later cross-aisle."""
-    rec = load_builtin_record("elcentro_1940_ns")
-    n = int(round(seconds / rec.dt)) + 1
-    lag = int(round(10.0 / rec.dt))
-    return combine(replace(rec, accel=scale * rec.accel[:n]),
-                   replace(rec, accel=scale * np.roll(rec.accel, -lag)[:n]))
+sys.path.insert(0, str(Path(__file__).parent))
+from test_local_front import _elcentro_pair  # noqa: E402
 
 
 def test_a_frozen_stuck_pallet_slips_past_its_capacity():
