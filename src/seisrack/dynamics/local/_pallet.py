@@ -116,13 +116,17 @@ def _return_map(zx, zz, kap, wa, wb, ca, sa):
             return 0.0, 1.0, 0.0, False
         return 0.0, (ca * xa - sa * xb) / nrm, (sa * xa + ca * xb) / nrm, False
     # Σ d_i² / (σ + κ w_i)² = 1 on [0, |z|]: Newton's method on φ(σ) = (Σ …)^(−1/2) − 1,
-    # linear in σ when wa = wb and nearly so otherwise, from the lower bound |z| − κ max w
-    # (2.3 steps on average over 28k random sub-steps, against 7.5 on the squared form,
-    # where a residual of exactly zero at the root led to 20–28 bisections); the bracket
-    # [lo, hi] guards the steps
+    # linear in σ when wa = wb and nearly so otherwise, from σ = |z| − Σ d_i² κ w_i / |z|²
+    # (exact when wa = wb, first order otherwise); a Newton step below 1e-8 of the scale
+    # leaves an error of its square, and ends the iteration. On the 150-pallet example
+    # (37.5 M return maps in 20 s) the squared form with the lower bound |z| − κ max w took
+    # more steps, and a residual of exactly zero at the root led it to 20–28 bisections.
+    # The bracket [lo, hi] guards the steps.
     lo = 0.0
-    hi = np.sqrt(zx * zx + zz * zz)
-    sig = max(0.0, hi - max(ka, kb))
+    z2 = zx * zx + zz * zz
+    hi = np.sqrt(z2)
+    sig = min(max(0.0, hi - (da * da * ka + db * db * kb) / z2), hi)
+    scale = hi + ka + kb
     for _ in range(100):
         pa = sig + ka
         pb = sig + kb
@@ -138,7 +142,8 @@ def _return_map(zx, zz, kap, wa, wb, ca, sa):
         rf = 1.0 / np.sqrt(f)
         dphi = rf * rf * rf * (qa * qa / pa + qb * qb / pb)
         nxt = sig - (rf - 1.0) / dphi if dphi > 0.0 else 0.5 * (lo + hi)
-        if abs(nxt - sig) <= 1e-15 * (sig + ka + kb):
+        step = abs(nxt - sig)
+        if step <= 1e-15 * scale or (step <= 1e-8 * scale and lo < nxt < hi):
             sig = nxt
             break
         if not (lo < nxt < hi):
