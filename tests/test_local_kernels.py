@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from btd_inputs import random_btd
 from seisrack.dynamics.local import _btd, _kernel, _pallet
 
 
@@ -30,30 +31,16 @@ def _numba():
 BUILDS = {"python": lambda: (_btd, _kernel, _pallet), "numba": lambda: (_numba(),) * 3}
 
 
-def _random_btd(sizes, rng):
-    ns, bmax = len(sizes), max(sizes)
-    off = np.concatenate([[0], np.cumsum(sizes)])
-    n = off[-1]
-    B = rng.standard_normal((n, n))
-    mask = np.zeros((n, n), dtype=bool)
-    for s in range(ns):
-        mask[off[s]:off[s + 1], off[max(s - 1, 0)]:off[min(s + 2, ns)]] = True
-    A = np.where(mask, B + B.T, 0.0) + 2.0 * n * np.eye(n)
-    Ad = np.zeros((ns, bmax, bmax))
-    Ao = np.zeros((ns - 1, bmax, bmax))
-    for s in range(ns):
-        b = sizes[s]
-        Ad[s, :b, :b] = A[off[s]:off[s + 1], off[s]:off[s + 1]]
-        if s + 1 < ns:
-            Ao[s, :b, :sizes[s + 1]] = A[off[s]:off[s + 1], off[s + 1]:off[s + 2]]
-    return A, Ad, Ao, np.array(sizes, dtype=np.int64), off[:-1].astype(np.int64)
+def _random_btd(sizes, seed):
+    A, Ad, Ao, sz, off = random_btd(sizes, seed)
+    return A, Ad, Ao, sz, off[:-1].astype(np.int64)
 
 
 @pytest.mark.parametrize("build", list(BUILDS))
 def test_block_product_is_the_dense_product(build):
     btd = BUILDS[build]()[0]
     rng = np.random.default_rng(3)
-    A, Ad, Ao, sizes, offsets = _random_btd([3, 7, 5, 1, 6, 4], rng)
+    A, Ad, Ao, sizes, offsets = _random_btd([3, 7, 5, 1, 6, 4], 3)
     x = rng.standard_normal(A.shape[0])
     x[4] = 0.0  # a zero entry is skipped, not mis-added
     out = rng.standard_normal(A.shape[0])
@@ -68,7 +55,7 @@ def test_newton_matrix_is_the_dense_sum(build, nd):
     kernel = BUILDS[build]()[1]
     rng = np.random.default_rng(5)
     sizes_l = [4, 6, 5]
-    A, Ad, Ao, sizes, offsets = _random_btd(sizes_l, rng)
+    A, Ad, Ao, sizes, offsets = _random_btd(sizes_l, 5)
     bmax = Ad.shape[1]
     m = 5
     ps = np.array([0, 1, 1, 2, 2], dtype=np.int64)
