@@ -1,13 +1,14 @@
-"""Where a local-engine run spends its time, by function (docs/theory/local_engine.md §4.8).
+"""Where a rack run spends its time, by function (docs/theory/local_engine.md §4.8).
 
-Runs one case of ``rack_row.py`` in this process, then writes ``/tmp/perf-<pid>.map``: the
-load address and size of every function of the local engine's numba build, read from each
+Runs one case of ``rack_row.py`` (engine ``local`` or ``planar``) in this process, then writes
+``/tmp/perf-<pid>.map``: the load address and size of every numba-compiled function of
+seisrack's loaded modules, read from each
 compiled library's object code (``nm``) and the address of its entry point. ``perf report``
 then names the numba functions (without the map they show as ``[JIT]`` addresses). The object
 code exists only for a fresh compile, so give numba an empty cache folder::
 
     NUMBA_CACHE_DIR=$(mktemp -d) perf record -F 500 -o perf.data \\
-        python benchmarks/perf_map.py <row.toml> 20
+        python benchmarks/perf_map.py local <row.toml> 20
     perf report -i perf.data --sort dso,sym --stdio
 
 The compile is in the profile too (``libllvmlite``, ``libpython``); the run's own CPU time is
@@ -43,13 +44,22 @@ def _symbols(obj: bytes) -> list[tuple[int, int, str]]:
     return rows
 
 
-def write_map(module) -> int:  # noqa: ANN001
-    """Write this process's perf map for the numba dispatchers of ``module``; returns the
-    number of functions mapped (0 when numba loaded them from its cache)."""
-    entries = set()
-    for obj in vars(module).values():
-        if not isinstance(obj, numba.core.registry.CPUDispatcher):
+def _dispatchers():  # noqa: ANN202
+    seen = set()
+    for name, module in list(sys.modules.items()):
+        if not name.startswith("seisrack") or module is None:
             continue
+        for obj in vars(module).values():
+            if isinstance(obj, numba.core.registry.CPUDispatcher) and id(obj) not in seen:
+                seen.add(id(obj))
+                yield obj
+
+
+def write_map() -> int:
+    """Write this process's perf map for the numba dispatchers of seisrack's loaded modules;
+    returns the number of functions mapped (0 when numba loaded them from its cache)."""
+    entries = set()
+    for obj in _dispatchers():
         for cres in obj.overloads.values():
             lib = cres.library
             try:
@@ -69,10 +79,10 @@ def write_map(module) -> int:  # noqa: ANN001
 
 
 def main() -> None:
-    if len(sys.argv) != 3:
-        raise SystemExit("usage: perf_map.py <row.toml> <seconds>")
-    res = rack_row.run_case("local", sys.argv[1], float(sys.argv[2]))
-    n = write_map(sys.modules["seisrack.dynamics.local._numba"])
+    if len(sys.argv) != 4 or sys.argv[1] not in ("local", "planar"):
+        raise SystemExit("usage: perf_map.py local|planar <row.toml> <seconds>")
+    res = rack_row.run_case(sys.argv[1], sys.argv[2], float(sys.argv[3]))
+    n = write_map()
     print(json.dumps({"cpu": res["cpu"], "work": res["work"], "mapped": n,
                       "map": f"/tmp/perf-{os.getpid()}.map"}))
     if n == 0:

@@ -1,6 +1,7 @@
 """Block-tridiagonal algebra of the local engine (``dynamics/local/_btd.py``).
 
-Reference: the dense inverse of the same matrix (numpy). The pallets' compliance
+Reference: the dense inverse of the same matrix (numpy), for the numba build and the
+pure-Python twin. The pallets' compliance
 ``G = P (H⁻¹)_ss Pᵀ`` (docs/theory/local_engine.md §4.1) needs the diagonal blocks of the
 inverse, i.e. slice s's block with the slices on both sides condensed, not only those on its
 left (the forward factor's ``L_ss L_ssᵀ``, which holds the right side fixed: on the 10-bay
@@ -16,13 +17,23 @@ from btd_inputs import random_btd as _random_btd
 from seisrack.dynamics.local import _btd
 
 
+def _build(name):
+    if name == "numba":
+        from seisrack.dynamics.local import _numba
+
+        return _numba
+    return _btd
+
+
+@pytest.mark.parametrize("build", ["python", "numba"])
 @pytest.mark.parametrize("sizes", [[3, 5, 2, 4, 4], [6], [2, 7]])
-def test_condensed_blocks_are_the_inverse_diagonal_blocks(sizes):
+def test_condensed_blocks_are_the_inverse_diagonal_blocks(sizes, build):
+    btd = _build(build)
     A, Hd, Ho, sz, off = _random_btd(sizes)
     Ld, X = np.zeros_like(Hd), np.zeros_like(Ho)
     Rb, Yb, Le = np.zeros_like(Hd), np.zeros_like(Hd), np.zeros_like(Hd)
-    assert _btd._btd_factor(Hd, Ho, sz, Ld, X)
-    assert _btd._btd_condensed(Hd, Ho, sz, X, Rb, Yb, Le)
+    assert btd._btd_factor(Hd, Ho, sz, Ld, X)
+    assert btd._btd_condensed(Hd, Ho, sz, X, Rb, Yb, Le)
     Ai = np.linalg.inv(A)
     for s, b in enumerate(sizes):
         L = np.tril(Le[s, :b, :b])
@@ -34,10 +45,12 @@ def test_condensed_blocks_are_the_inverse_diagonal_blocks(sizes):
         assert not np.allclose(np.linalg.inv(L0 @ L0.T), Ai[:sizes[0], :sizes[0]])
 
 
-def test_condensed_refuses_an_indefinite_matrix():
+@pytest.mark.parametrize("build", ["python", "numba"])
+def test_condensed_refuses_an_indefinite_matrix(build):
+    btd = _build(build)
     A, Hd, Ho, sz, off = _random_btd([3, 3, 3], seed=1)
     Hd[1] -= 1e3 * np.eye(Hd.shape[1])
     Ld, X = np.zeros_like(Hd), np.zeros_like(Ho)
-    _btd._btd_factor(Hd, Ho, sz, Ld, X)
-    assert not _btd._btd_condensed(Hd, Ho, sz, X, np.zeros_like(Hd), np.zeros_like(Hd),
+    btd._btd_factor(Hd, Ho, sz, Ld, X)
+    assert not btd._btd_condensed(Hd, Ho, sz, X, np.zeros_like(Hd), np.zeros_like(Hd),
                                    np.zeros_like(Hd))

@@ -74,42 +74,48 @@ def _damp_off(Co, v, out):
 
 
 @_JIT
-def _friction(a, p, h, c2, PF, mass, mud, N1, yx, yz, lam, G, ng):
-    """Friction of sliding pallet ``p`` (rows ``2a``, ``2a + 1`` of the sliding pallets'
-    ``PF`` and ``lam``) at the end of the step from ``y``, its relative velocity without this
-    step's friction (``y = zf - c2 P_p dq``): outside the disc |y| > c = h mu_d N / (2 m) it
-    slides on, lam = -mu_d N y/|y|; inside, it would stop within the step, lam = -(2 m / h) y
-    (the return map, continuous and monotone in y). Unless ``G`` is empty, writes the rows
-    ``g`` of the Jacobian of lam (times c2 P_p) = Σ gᵀ g from row ``ng`` of ``G``; returns the
-    next free row."""
+def _frictions(n_slide, sl, h, c2, PF, mass, mud, N1, zf, pd, lam, G, jac):
+    """Friction of the sliding pallets ``sl[:n_slide]`` (rows ``2a``, ``2a + 1`` of ``PF``,
+    ``zf``, ``pd`` and ``lam`` for the a-th) at the end of the step from ``y = zf − c2 pd``,
+    a pallet's relative velocity without this step's friction: outside the disc
+    |y| > c = h mu_d N / (2 m) it slides on, lam = −mu_d N y/|y|; inside, it would stop within
+    the step, lam = −(2 m / h) y (the return map, continuous and monotone in y). When ``jac``,
+    writes the rows ``g`` of the Jacobian of lam (times c2 P_p) = Σ gᵀ g from the first row of
+    ``G``; returns the number of rows. One call for all of them: numba counts a reference to
+    every array argument of a call (an atomic increment and decrement), which per pallet and
+    Newton iteration was about a sixth of the 150-pallet example's run."""
     r = PF.shape[1]
-    jx = 2 * a
-    jz = jx + 1
-    yn = np.sqrt(yx * yx + yz * yz)
-    f = mud[p] * N1[p]
-    cc = 0.5 * h * f / mass[p]
-    jac = G.shape[0] > 0
-    if yn > cc and yn > 0.0:
-        lam[jx] = -f * yx / yn
-        lam[jz] = -f * yz / yn
-        if jac:
-            # rank one, across the direction of sliding
-            b = np.sqrt(f * c2 / yn)
-            tx = -b * yz / yn
-            tz = b * yx / yn
-            for i in range(r):
-                G[ng, i] = PF[jx, i] * tx + PF[jz, i] * tz
-            ng += 1
-    else:
-        km = 2.0 * mass[p] / h
-        lam[jx] = -km * yx
-        lam[jz] = -km * yz
-        if jac:
-            b = np.sqrt(km * c2)
-            for i in range(r):
-                G[ng, i] = b * PF[jx, i]
-                G[ng + 1, i] = b * PF[jz, i]
-            ng += 2
+    ng = 0
+    for a in range(n_slide):
+        p = sl[a]
+        jx = 2 * a
+        jz = jx + 1
+        yx = zf[jx] - c2 * pd[jx]
+        yz = zf[jz] - c2 * pd[jz]
+        yn = np.sqrt(yx * yx + yz * yz)
+        f = mud[p] * N1[p]
+        cc = 0.5 * h * f / mass[p]
+        if yn > cc and yn > 0.0:
+            lam[jx] = -f * yx / yn
+            lam[jz] = -f * yz / yn
+            if jac:
+                # rank one, across the direction of sliding
+                b = np.sqrt(f * c2 / yn)
+                tx = -b * yz / yn
+                tz = b * yx / yn
+                for i in range(r):
+                    G[ng, i] = PF[jx, i] * tx + PF[jz, i] * tz
+                ng += 1
+        else:
+            km = 2.0 * mass[p] / h
+            lam[jx] = -km * yx
+            lam[jz] = -km * yz
+            if jac:
+                b = np.sqrt(km * c2)
+                for i in range(r):
+                    G[ng, i] = b * PF[jx, i]
+                    G[ng + 1, i] = b * PF[jz, i]
+                ng += 2
     return ng
 
 
@@ -264,14 +270,12 @@ def _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn, ag1
             rlin[i] = rhs[i] - dg[i] * dq[i] - c0 * sd[i] - c2 * od[i]
         ymax = 0.0
         hub0 = 0.0
-        ng = 0
+        ng = _frictions(n_slide, sl, h, c2, PFs, mass, mud, N1, zf, pd, lam, G, refac)
         for a in range(n_slide):
             p = sl[a]
             jx = 2 * a
             yx = zf[jx] - c2 * pd[jx]
             yz = zf[jx + 1] - c2 * pd[jx + 1]
-            ng = _friction(a, p, h, c2, PFs, mass, mud, N1, yx, yz, lam, G if refac else G[:0],
-                           ng)
             hub0 += _huber(yx, yz, 0.5 * h * mud[p] * N1[p] / mass[p], mass[p], h)
             ymax = max(ymax, abs(zf[jx]) + abs(zf[jx + 1]) + mud[p] * N1[p] * h / mass[p])
         res[:] = rlin - np.dot(lam, PFs)
@@ -376,10 +380,7 @@ def _trial(h, kq, kw, kd, cd, Co, P, mass, mus, mud, S, T0, N0, stuck, dirn, ag1
             x0[i] = q0[i] + dq[i]
         _hinge_eval(Q, hth0, hk, hlaw, hpar, hst_c, hst_t, x0, hM, hz)
     if n_slide > 0:
-        for a in range(n_slide):
-            jx = 2 * a
-            _friction(a, sl[a], h, c2, PFs, mass, mud, N1, zf[jx] - c2 * pd[jx],
-                      zf[jx + 1] - c2 * pd[jx + 1], lam, G[:0], 0)
+        _frictions(n_slide, sl, h, c2, PFs, mass, mud, N1, zf, pd, lam, G, False)
     # end state
     q1, qd1, qdd1 = T1[0], T1[1], T1[2]
     w1, wd1, wdd1, lam1, s1, vn1 = S1[0], S1[1], S1[2], S1[3], S1[4], S1[5]

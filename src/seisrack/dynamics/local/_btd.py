@@ -74,7 +74,8 @@ def _btd_condensed(Hd, Ho, sizes, X, Rb, Yb, Le):
     Y_sᵀ Y_s``: slice s's block with both sides condensed, the left from the forward factor
     (``X`` of :func:`_btd_factor`), the right from a backward one (``Rb[s]`` = chol of the
     right-condensed ``T_s``, ``Yb[s] = Rb[s+1]⁻¹ H_(s+1, s)``). ``P (Le Leᵀ)⁻¹ Pᵀ`` is then
-    the exact compliance of slice s's DOFs (theory §4.1). Cost about that of one factor.
+    the exact compliance of slice s's DOFs (theory §4.1). Cost about that of one factor
+    (``E_s`` starts from the backward sweep's ``T_s = H_ss − Y_sᵀ Y_s``).
     False if a block is not positive definite."""
     ns = sizes.shape[0]
     for s in range(ns - 1, -1, -1):
@@ -85,6 +86,11 @@ def _btd_condensed(Hd, Ho, sizes, X, Rb, Yb, Le):
                 R[i, k] = Hd[s, i, k]
         if s + 1 < ns:
             _syrk_corner(R, b, Yb[s], sizes[s + 1])
+        # T_s = H_ss − Y_sᵀ Y_s kept for E_s below (one product fewer per slice)
+        E = Le[s]
+        for i in range(b):
+            for k in range(i + 1):
+                E[i, k] = R[i, k]
         if not _potrf_corner(R, b):
             return False
         if s > 0:
@@ -98,13 +104,8 @@ def _btd_condensed(Hd, Ho, sizes, X, Rb, Yb, Le):
     for s in range(ns):
         b = sizes[s]
         E = Le[s]
-        for i in range(b):
-            for k in range(i + 1):
-                E[i, k] = Hd[s, i, k]
         if s > 0:
             _syrk_corner(E, b, X[s - 1], sizes[s - 1])
-        if s + 1 < ns:
-            _syrk_corner(E, b, Yb[s], sizes[s + 1])
         if not _potrf_corner(E, b):
             return False
     return True
